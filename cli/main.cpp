@@ -1,0 +1,107 @@
+// c3po: certifiable object pose estimation from partial point clouds.
+// A table of (name, summary, example, Setup) entries; each subcommand lives in
+// its own file (cli/<name>.cpp).
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "c3po/error.hpp"
+#include "c3po/plugins/registry.hpp"
+#include "command.hpp"
+#include "common.hpp"
+
+namespace {
+
+using c3po::cli::RunFunction;
+
+struct CommandEntry {
+  const char* name;
+  const char* summary;
+  const char* example;
+  RunFunction (*setup)(CLI::App&);
+};
+
+const std::vector<CommandEntry>& Commands() {
+  static const std::vector<CommandEntry> commands = {
+      {"annotate", "Make an object file: keypoints on a CAD mesh",
+       "c3po annotate mug.obj --keypoint 0.04,0,0.09 --name rim -o mug.json",
+       c3po::cli::SetupAnnotate},
+      {"indicators", "List, edit or learn the object's indicator sets",
+       "c3po indicators mug.json --set 9 -o mug.json", c3po::cli::SetupIndicators},
+      {"synth", "Make simulated (sim) or rendered depth (depth) clouds with ground truth",
+       "c3po synth mug.json -o data/mug_depth --kind depth --count 200 --seed 1",
+       c3po::cli::SetupSynth},
+      {"train", "Train a keypoint detector on labelled clouds",
+       "c3po train mug.json --data data/mug_sim -o mug.model --epochs 10",
+       c3po::cli::SetupTrain},
+      {"selftrain", "Self-train a detector on unlabelled clouds from its certified outputs",
+       "c3po selftrain mug.json --model mug.model --data data/mug_depth -o mug_self.model",
+       c3po::cli::SetupSelftrain},
+      {"certify", "Estimate poses and certify them (JSON lines, exit 0/1/2)",
+       "c3po certify mug.json --model mug.model cloud.ply --json", c3po::cli::SetupCertify},
+      {"eval", "Evaluate detectors, corrector and certificates against ground truth",
+       "c3po eval mug.json --model mug.model --data data/mug_depth --report report.html",
+       c3po::cli::SetupEval},
+      {"bench", "Measure speed and accuracy of components (prints figures)",
+       "c3po bench corrector mug.json --data data/mug_depth", c3po::cli::SetupBench},
+      {"demo", "Run the whole method on a bundled object (README's first command)",
+       "c3po demo --out demo_out", c3po::cli::SetupDemo},
+  };
+  return commands;
+}
+
+std::string DetectorList() {
+  std::string text = "Detectors:\n";
+  for (const auto& info : c3po::ListDetectors()) {
+    text += "  " + info.name + (info.needs_model_file ? " (trained, --model FILE)" : "") +
+            ": " + info.description + "\n";
+  }
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"c3po: certifiable object pose estimation from partial point clouds (C-3PO)"};
+  app.set_version_flag("--version", std::string("c3po ") + C3PO_VERSION);
+  app.require_subcommand(1);
+  app.footer(DetectorList());
+
+  std::vector<std::pair<CLI::App*, RunFunction>> runners;
+  for (const auto& entry : Commands()) {
+    CLI::App* command = app.add_subcommand(entry.name, entry.summary);
+    command->footer(std::string("Example:\n  ") + entry.example);
+    runners.emplace_back(command, entry.setup(*command));
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);   // prints help / version / the error
+    return code == 0 ? 0 : 2;
+  }
+
+  c3po::cli::InstallInterruptHandlers();
+  for (auto& [command, run] : runners) {
+    if (!command->parsed()) continue;
+    const std::string prefix = std::string("c3po ") + command->get_name() + ": ";
+    try {
+      return run();
+    } catch (const c3po::InputError& e) {
+      std::cerr << prefix << e.what() << "\n";
+      return 2;
+    } catch (const c3po::Interrupted&) {
+      std::cerr << prefix << "interrupted; completed outputs were kept\n";
+      return 130;
+    } catch (const std::bad_alloc&) {
+      std::cerr << prefix << "out of memory\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << prefix << e.what() << "\n";
+      return 2;
+    }
+  }
+  return 2;
+}

@@ -1,0 +1,32 @@
+#pragma once
+// Basic geometric types. A point set is 3xN, one point per column; a pose maps
+// model coordinates to scene coordinates: x_scene = R * x_model + t.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace c3po {
+
+using PointSet = Eigen::Matrix3Xd;
+
+struct Pose {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+
+  static Pose Identity() { return {}; }
+
+  // x_scene = R x_model + t
+  Eigen::Vector3d operator*(const Eigen::Vector3d& x) const { return R * x + t; }
+  PointSet operator*(const PointSet& points) const {
+    return (R * points).colwise() + t;
+  }
+  // (this * other)(x) = this(other(x))
+  Pose operator*(const Pose& other) const { return {R * other.R, R * other.t + t}; }
+  Pose Inverse() const { return {R.transpose(), -(R.transpose() * t)}; }
+  // Applies the inverse without forming it: R^T (x - t).
+  PointSet InverseApply(const PointSet& points) const {
+    return R.transpose() * (points.colwise() - t);
+  }
+  bool IsFinite() const { return R.allFinite() && t.allFinite(); }
+};
+
+}  // namespace c3po

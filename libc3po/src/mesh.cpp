@@ -1,0 +1,199 @@
+#include "c3po/mesh.hpp"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <filesystem>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "c3po/atomic_file.hpp"
+#include "c3po/error.hpp"
+#include "c3po/random.hpp"
+
+namespace c3po {
+namespace {
+
+Eigen::Vector3d Corner(const Mesh& mesh, int triangle, int k) {
+  return mesh.vertices.col(mesh.triangles(k, triangle));
+}
+
+double TriangleArea(const Mesh& mesh, int t) {
+  const Eigen::Vector3d a = Corner(mesh, t, 0), b = Corner(mesh, t, 1), c = Corner(mesh, t, 2);
+  return 0.5 * (b - a).cross(c - a).norm();
+}
+
+// Appends one assimp mesh (triangles only; points and lines are skipped).
+void AppendAssimpMesh(const aiMesh& source, const aiMatrix4x4& to_root, double scale,
+                      std::vector<Eigen::Vector3d>* vertices,
+                      std::vector<Eigen::Vector3i>* triangles) {
+  const int offset = static_cast<int>(vertices->size());
+  for (unsigned i = 0; i < source.mNumVertices; ++i) {
+    const aiVector3D v = to_root * source.mVertices[i];
+    vertices->emplace_back(scale * v.x, scale * v.y, scale * v.z);
+  }
+  for (unsigned f = 0; f < source.mNumFaces; ++f) {
+    const aiFace& face = source.mFaces[f];
+    if (face.mNumIndices != 3) continue;
+    triangles->emplace_back(offset + static_cast<int>(face.mIndices[0]),
+                            offset + static_cast<int>(face.mIndices[1]),
+                            offset + static_cast<int>(face.mIndices[2]));
+  }
+}
+
+void CollectNode(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent,
+                 double scale, std::vector<Eigen::Vector3d>* vertices,
+                 std::vector<Eigen::Vector3i>* triangles, int depth) {
+  if (depth > 64) return;  // pathological node nesting
+  const aiMatrix4x4 to_root = parent * node.mTransformation;
+  for (unsigned m = 0; m < node.mNumMeshes; ++m) {
+    if (node.mMeshes[m] < scene.mNumMeshes) {
+      AppendAssimpMesh(*scene.mMeshes[node.mMeshes[m]], to_root, scale, vertices, triangles);
+    }
+  }
+  for (unsigned c = 0; c < node.mNumChildren; ++c) {
+    CollectNode(scene, *node.mChildren[c], to_root, scale, vertices, triangles, depth + 1);
+  }
+}
+
+}  // namespace
+
+double Mesh::SurfaceArea() const {
+  double area = 0.0;
+  for (int t = 0; t < triangles.cols(); ++t) area += TriangleArea(*this, t);
+  return area;
+}
+
+Eigen::AlignedBox3d Mesh::BoundingBox() const {
+  Eigen::AlignedBox3d box;
+  for (int i = 0; i < vertices.cols(); ++i) box.extend(vertices.col(i));
+  return box;
+}
+
+void Mesh::Validate() const {
+  if (!vertices.allFinite()) throw std::invalid_argument("mesh has non-finite vertices");
+  if (triangles.size() > 0 &&
+      (triangles.minCoeff() < 0 || triangles.maxCoeff() >= vertices.cols())) {
+    throw std::invalid_argument("mesh has out-of-range triangle indices");
+  }
+}
+
+Mesh LoadMesh(const std::string& path, double scale) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "mesh file not found");
+  Assimp::Importer importer;
+  // No normals, no materials: only triangulated geometry with merged vertices.
+  const aiScene* scene = importer.ReadFile(
+      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    std::string reason = importer.GetErrorString();
+    std::replace(reason.begin(), reason.end(), '\n', ' ');
+    throw InputError(path, "cannot read mesh: " + (reason.empty() ? "unknown format" : reason));
+  }
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Eigen::Vector3i> triangles;
+  CollectNode(*scene, *scene->mRootNode, aiMatrix4x4(), scale, &vertices, &triangles, 0);
+  if (triangles.empty()) throw InputError(path, "mesh has no triangles");
+  Mesh mesh;
+  mesh.vertices.resize(3, static_cast<Eigen::Index>(vertices.size()));
+  for (std::size_t i = 0; i < vertices.size(); ++i) mesh.vertices.col(i) = vertices[i];
+  mesh.triangles.resize(3, static_cast<Eigen::Index>(triangles.size()));
+  for (std::size_t i = 0; i < triangles.size(); ++i) mesh.triangles.col(i) = triangles[i];
+  if (!mesh.vertices.allFinite()) throw InputError(path, "mesh has non-finite vertex coordinates");
+  if (!(mesh.SurfaceArea() > 0.0)) throw InputError(path, "mesh has zero surface area");
+  return mesh;
+}
+
+void WriteObj(const Mesh& mesh, const std::string& path) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "# written by c3po\n" << std::setprecision(9);
+    for (int i = 0; i < mesh.vertices.cols(); ++i) {
+      out << "v " << mesh.vertices(0, i) << ' ' << mesh.vertices(1, i) << ' '
+          << mesh.vertices(2, i) << '\n';
+    }
+    for (int t = 0; t < mesh.triangles.cols(); ++t) {
+      out << "f " << mesh.triangles(0, t) + 1 << ' ' << mesh.triangles(1, t) + 1 << ' '
+          << mesh.triangles(2, t) + 1 << '\n';
+    }
+  });
+}
+
+SurfaceSample SampleSurfaceWithTriangles(const Mesh& mesh, int count, std::uint64_t seed) {
+  if (mesh.empty()) throw std::invalid_argument("SampleSurface: mesh has no triangles");
+  if (count < 0) throw std::invalid_argument("SampleSurface: negative count");
+  // Cumulative area table; a triangle is picked with probability area / total.
+  std::vector<double> cumulative(mesh.triangles.cols());
+  double total = 0.0;
+  for (int t = 0; t < mesh.triangles.cols(); ++t) {
+    total += TriangleArea(mesh, t);
+    cumulative[t] = total;
+  }
+  if (!(total > 0.0)) throw std::invalid_argument("SampleSurface: zero surface area");
+  Rng rng(seed);
+  SurfaceSample sample;
+  sample.points.resize(3, count);
+  sample.triangle.resize(count);
+  for (int i = 0; i < count; ++i) {
+    const double target = rng.Uniform() * total;
+    int t = static_cast<int>(std::upper_bound(cumulative.begin(), cumulative.end(), target) -
+                             cumulative.begin());
+    t = std::min<int>(t, static_cast<int>(mesh.triangles.cols()) - 1);
+    // Uniform point in a triangle: reflect (u, v) outside the lower half.
+    double u = rng.Uniform(), v = rng.Uniform();
+    if (u + v > 1.0) {
+      u = 1.0 - u;
+      v = 1.0 - v;
+    }
+    const Eigen::Vector3d a = Corner(mesh, t, 0), b = Corner(mesh, t, 1), c = Corner(mesh, t, 2);
+    sample.points.col(i) = a + u * (b - a) + v * (c - a);
+    sample.triangle(i) = t;
+  }
+  return sample;
+}
+
+PointSet SampleSurface(const Mesh& mesh, int count, std::uint64_t seed) {
+  return SampleSurfaceWithTriangles(mesh, count, seed).points;
+}
+
+// Ericson, Real-Time Collision Detection, section 5.1.5 (Voronoi regions).
+Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  if (!std::isfinite(denom)) return a;  // degenerate (zero-area) triangle
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+SurfacePoint ClosestSurfacePoint(const Mesh& mesh, const Eigen::Vector3d& p) {
+  SurfacePoint best;
+  best.distance = std::numeric_limits<double>::infinity();
+  for (int t = 0; t < mesh.triangles.cols(); ++t) {
+    const Eigen::Vector3d q =
+        ClosestPointOnTriangle(p, Corner(mesh, t, 0), Corner(mesh, t, 1), Corner(mesh, t, 2));
+    const double d = (q - p).norm();
+    if (d < best.distance) best = {q, t, d};
+  }
+  return best;
+}
+
+}  // namespace c3po

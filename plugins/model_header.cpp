@@ -1,0 +1,36 @@
+// Model files start with one line of JSON: {"magic": "c3po-model", "detector": NAME, ...}.
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "c3po/error.hpp"
+#include "registry_internal.hpp"
+
+namespace c3po {
+
+std::string ReadModelDetectorName(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open model file");
+  std::string line;
+  line.reserve(4096);
+  char c;
+  while (in.get(c) && c != '\n') {
+    line.push_back(c);
+    if (line.size() > (1u << 20)) throw InputError(path, "not a c3po model file (no header line)");
+  }
+  nlohmann::json header;
+  try {
+    header = nlohmann::json::parse(line);
+  } catch (const nlohmann::json::exception&) {
+    throw InputError(path, "not a c3po model file (header is not JSON)");
+  }
+  if (!header.is_object() || header.value("magic", "") != "c3po-model") {
+    throw InputError(path, "not a c3po model file (missing magic \"c3po-model\")");
+  }
+  if (!header.contains("detector") || !header["detector"].is_string()) {
+    throw InputError(path, "model header has no detector name");
+  }
+  return header["detector"].get<std::string>();
+}
+
+}  // namespace c3po

@@ -1,0 +1,21 @@
+#pragma once
+// Registry internals shared by registry.cpp, plugin_loader.cpp and builtins.cpp.
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "c3po/plugins/registry.hpp"
+
+namespace c3po {
+
+using ModelLoader =
+    std::function<std::unique_ptr<Detector>(const std::string& path, const ObjectModel&)>;
+
+void RegisterModelLoader(const DetectorInfo& info, ModelLoader loader);
+// Registers svd, pointnet (when built), ...; called once on first registry use.
+void RegisterBuiltinDetectors();
+// Reads the "detector" field of a model file's JSON header line. Throws
+// InputError("path: ...") when the file is not a c3po model.
+std::string ReadModelDetectorName(const std::string& path);
+
+}  // namespace c3po
