@@ -1,0 +1,270 @@
+// Pinhole depth renderer: z-buffer rasterisation + exact back-projection
+// (render.hpp).
+#include "c3po/render.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include "c3po/error.hpp"
+
+namespace c3po {
+namespace {
+
+// Twice the signed area of (a, b, p): > 0 when p is left of a->b.
+inline double Edge(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double u, double v) {
+  return (b.x() - a.x()) * (v - a.y()) - (b.y() - a.y()) * (u - a.x());
+}
+
+// Ray parameter s with s * ray on the plane of triangle (a, b, c); NaN when
+// the ray is parallel to the plane.
+inline double RayPlane(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                       const Eigen::Vector3d& c, const Eigen::Vector3d& ray) {
+  const Eigen::Vector3d normal = (b - a).cross(c - a);
+  const double denominator = normal.dot(ray);
+  if (denominator == 0.0) return std::numeric_limits<double>::quiet_NaN();
+  return normal.dot(a) / denominator;
+}
+
+}  // namespace
+
+void CameraIntrinsics::Check() const {
+  const bool finite = std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) &&
+                      std::isfinite(cy);
+  if (!finite || !(fx > 0.0) || !(fy > 0.0)) {
+    throw InputError("intrinsics: focal lengths must be finite and positive");
+  }
+  if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
+    throw InputError("intrinsics: image size must be between 1 and 16384 pixels");
+  }
+}
+
+CameraIntrinsics ParseIntrinsics(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw InputError("--intrinsics: '" + item + "' is not a number");
+    }
+  }
+  if (values.size() != 6) throw InputError("--intrinsics: expected fx,fy,cx,cy,width,height");
+  CameraIntrinsics camera;
+  camera.fx = values[0];
+  camera.fy = values[1];
+  camera.cx = values[2];
+  camera.cy = values[3];
+  if (values[4] != std::floor(values[4]) || values[5] != std::floor(values[5]) ||
+      !(std::abs(values[4]) < 1e6) || !(std::abs(values[5]) < 1e6)) {
+    throw InputError("--intrinsics: width and height must be whole numbers of pixels");
+  }
+  camera.width = static_cast<int>(values[4]);
+  camera.height = static_cast<int>(values[5]);
+  camera.Check();
+  return camera;
+}
+
+void DepthSampleOptions::Check() const {
+  if (points < 1) throw InputError("--points: must be at least 1");
+  if (!(noise_sigma >= 0.0) || !std::isfinite(noise_sigma)) {
+    throw InputError("--noise: must be a finite distance >= 0");
+  }
+  if (!(dropout >= 0.0 && dropout < 1.0)) throw InputError("--dropout: must be in [0, 1)");
+}
+
+DepthRenderer::DepthRenderer(const CameraIntrinsics& camera) : camera_(camera) {
+  camera_.Check();
+  const std::size_t pixels = static_cast<std::size_t>(camera_.width) * camera_.height;
+  inverse_depth_.assign(pixels, 0.0);
+  triangle_.assign(pixels, -1);
+}
+
+void DepthRenderer::ClearRectangle() {
+  for (int v = rect_v0_; v <= rect_v1_; ++v) {
+    const std::size_t row = static_cast<std::size_t>(v) * camera_.width;
+    std::fill(inverse_depth_.begin() + row + rect_u0_, inverse_depth_.begin() + row + rect_u1_ + 1,
+              0.0);
+    std::fill(triangle_.begin() + row + rect_u0_, triangle_.begin() + row + rect_u1_ + 1, -1);
+  }
+  rect_u0_ = rect_v0_ = 0;
+  rect_u1_ = rect_v1_ = -1;
+}
+
+void DepthRenderer::Render(const Mesh& mesh, const Pose& camera_from_model) {
+  ClearRectangle();
+  covered_.clear();
+  triangles_ = &mesh.triangles;
+  camera_vertices_ = camera_from_model * mesh.vertices;
+  const Eigen::Index count = camera_vertices_.cols();
+  projected_.resize(2, count);
+  double u_min = HUGE_VAL, u_max = -HUGE_VAL, v_min = HUGE_VAL, v_max = -HUGE_VAL;
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const Eigen::Vector3d p = camera_vertices_.col(i);
+    if (!(p.z() > kNearPlane)) {
+      projected_.col(i).setConstant(std::numeric_limits<double>::quiet_NaN());
+      continue;
+    }
+    const double u = camera_.fx * p.x() / p.z() + camera_.cx;
+    const double v = camera_.fy * p.y() / p.z() + camera_.cy;
+    projected_.col(i) << u, v;
+    u_min = std::min(u_min, u);
+    u_max = std::max(u_max, u);
+    v_min = std::min(v_min, v);
+    v_max = std::max(v_max, v);
+  }
+  // Pixel centres are at integer coordinates; clip the rectangle to the image.
+  // (An empty view leaves u_min = +inf, u_max = -inf: clamping keeps the casts defined.)
+  const auto clamp = [](double x, double lo, double hi) { return std::min(hi, std::max(lo, x)); };
+  rect_u0_ = static_cast<int>(clamp(std::ceil(u_min), 0.0, camera_.width));
+  rect_v0_ = static_cast<int>(clamp(std::ceil(v_min), 0.0, camera_.height));
+  rect_u1_ = static_cast<int>(clamp(std::floor(u_max), -1.0, camera_.width - 1.0));
+  rect_v1_ = static_cast<int>(clamp(std::floor(v_max), -1.0, camera_.height - 1.0));
+  if (rect_u0_ > rect_u1_ || rect_v0_ > rect_v1_) {
+    rect_u0_ = rect_v0_ = 0;
+    rect_u1_ = rect_v1_ = -1;
+    return;
+  }
+  for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) RasterizeTriangle(static_cast<int>(t));
+  for (int v = rect_v0_; v <= rect_v1_; ++v) {
+    const int row = v * camera_.width;
+    for (int u = rect_u0_; u <= rect_u1_; ++u) {
+      if (triangle_[static_cast<std::size_t>(row + u)] >= 0) covered_.push_back(row + u);
+    }
+  }
+}
+
+void DepthRenderer::RasterizeTriangle(int t) {
+  const Eigen::Vector3i tri = triangles_->col(t);
+  const Eigen::Vector2d a = projected_.col(tri[0]);
+  const Eigen::Vector2d b = projected_.col(tri[1]);
+  const Eigen::Vector2d c = projected_.col(tri[2]);
+  if (!(a.allFinite() && b.allFinite() && c.allFinite())) return;   // behind the near plane
+  double area = Edge(a, b, c.x(), c.y());
+  if (area == 0.0) return;
+  const double u_lo = std::max<double>(rect_u0_, std::ceil(std::min({a.x(), b.x(), c.x()})));
+  const double u_hi = std::min<double>(rect_u1_, std::floor(std::max({a.x(), b.x(), c.x()})));
+  const double v_lo = std::max<double>(rect_v0_, std::ceil(std::min({a.y(), b.y(), c.y()})));
+  const double v_hi = std::min<double>(rect_v1_, std::floor(std::max({a.y(), b.y(), c.y()})));
+  if (u_lo > u_hi || v_lo > v_hi) return;
+  // Barycentric weights scaled by 1/area so that inside means all >= 0.
+  const double sign = area > 0.0 ? 1.0 : -1.0;
+  area = std::abs(area);
+  const double inv_za = 1.0 / camera_vertices_(2, tri[0]);
+  const double inv_zb = 1.0 / camera_vertices_(2, tri[1]);
+  const double inv_zc = 1.0 / camera_vertices_(2, tri[2]);
+  for (int v = static_cast<int>(v_lo); v <= static_cast<int>(v_hi); ++v) {
+    const std::size_t row = static_cast<std::size_t>(v) * camera_.width;
+    for (int u = static_cast<int>(u_lo); u <= static_cast<int>(u_hi); ++u) {
+      const double wa = sign * Edge(b, c, u, v);
+      const double wb = sign * Edge(c, a, u, v);
+      const double wc = sign * Edge(a, b, u, v);
+      if (wa < 0.0 || wb < 0.0 || wc < 0.0) continue;
+      // 1/z is affine in screen space (perspective-correct depth).
+      const double inverse_depth = (wa * inv_za + wb * inv_zb + wc * inv_zc) / area;
+      const std::size_t pixel = row + static_cast<std::size_t>(u);
+      if (inverse_depth > inverse_depth_[pixel]) {
+        inverse_depth_[pixel] = inverse_depth;
+        triangle_[pixel] = t;
+      }
+    }
+  }
+}
+
+int DepthRenderer::TriangleAt(int u, int v) const {
+  if (u < 0 || v < 0 || u >= camera_.width || v >= camera_.height) return -1;
+  return triangle_[static_cast<std::size_t>(v) * camera_.width + u];
+}
+
+double DepthRenderer::DepthAt(int u, int v) const {
+  const int t = TriangleAt(u, v);
+  if (t < 0) return std::numeric_limits<double>::infinity();
+  return BackProject(v * camera_.width + u).z();
+}
+
+Eigen::Vector3d DepthRenderer::BackProject(int pixel) const {
+  const int t = triangle_[static_cast<std::size_t>(pixel)];
+  const Eigen::Vector3i tri = triangles_->col(t);
+  const Eigen::Vector3d ray = camera_.Ray(pixel % camera_.width, pixel / camera_.width);
+  const double s = RayPlane(camera_vertices_.col(tri[0]), camera_vertices_.col(tri[1]),
+                            camera_vertices_.col(tri[2]), ray);
+  return s * ray;
+}
+
+PointSet DepthRenderer::SampleCloud(const DepthSampleOptions& options, Rng& rng,
+                                    Eigen::VectorXi* triangles) const {
+  std::vector<int> pixels = covered_;
+  const std::size_t keep = std::min(pixels.size(), static_cast<std::size_t>(options.points));
+  // Partial Fisher-Yates: the first `keep` entries are a uniform subset.
+  if (keep < pixels.size()) {
+    for (std::size_t i = 0; i < keep; ++i) {
+      const std::size_t j = i + static_cast<std::size_t>(
+                                    rng.UniformInt(static_cast<int>(pixels.size() - i)));
+      std::swap(pixels[i], pixels[j]);
+    }
+  }
+  PointSet cloud(3, static_cast<Eigen::Index>(keep));
+  std::vector<int> kept_triangles;
+  Eigen::Index count = 0;
+  for (std::size_t i = 0; i < keep; ++i) {
+    if (options.dropout > 0.0 && rng.Uniform() < options.dropout) continue;
+    Eigen::Vector3d point = BackProject(pixels[i]);
+    if (options.noise_sigma > 0.0) {
+      // Depth noise: z -> z + sigma * N(0, 1), along the pixel ray.
+      point *= (point.z() + options.noise_sigma * rng.Normal()) / point.z();
+    }
+    cloud.col(count++) = point;
+    kept_triangles.push_back(triangle_[static_cast<std::size_t>(pixels[i])]);
+  }
+  cloud.conservativeResize(3, count);
+  if (triangles) {
+    *triangles = Eigen::Map<const Eigen::VectorXi>(kept_triangles.data(),
+                                                   static_cast<Eigen::Index>(kept_triangles.size()));
+  }
+  return cloud;
+}
+
+std::vector<bool> DepthRenderer::KeypointsVisible(const PointSet& camera_keypoints,
+                                                  double tolerance) const {
+  std::vector<bool> visible(static_cast<std::size_t>(camera_keypoints.cols()), false);
+  if (!triangles_) return visible;
+  for (Eigen::Index k = 0; k < camera_keypoints.cols(); ++k) {
+    const Eigen::Vector3d p = camera_keypoints.col(k);
+    if (!(p.z() > kNearPlane)) continue;
+    const double u = camera_.fx * p.x() / p.z() + camera_.cx;
+    const double v = camera_.fy * p.y() / p.z() + camera_.cy;
+    if (!(u >= -0.5 && u < camera_.width - 0.5 && v >= -0.5 && v < camera_.height - 0.5)) continue;
+    // Occluded when a triangle meets the ray s * p at s < 1 - tolerance / |p|.
+    const double s_limit = 1.0 - tolerance / p.norm();
+    bool occluded = false;
+    for (Eigen::Index t = 0; t < triangles_->cols() && !occluded; ++t) {
+      const Eigen::Vector3i tri = triangles_->col(t);
+      const Eigen::Vector2d a = projected_.col(tri[0]);
+      const Eigen::Vector2d b = projected_.col(tri[1]);
+      const Eigen::Vector2d c = projected_.col(tri[2]);
+      if (!(std::min({a.x(), b.x(), c.x()}) <= u && std::max({a.x(), b.x(), c.x()}) >= u &&
+            std::min({a.y(), b.y(), c.y()}) <= v && std::max({a.y(), b.y(), c.y()}) >= v)) {
+        continue;
+      }
+      if (!(a.allFinite() && b.allFinite() && c.allFinite())) continue;   // behind the camera
+      const double area = Edge(a, b, c.x(), c.y());
+      const double sign = area >= 0.0 ? 1.0 : -1.0;
+      if (sign * Edge(b, c, u, v) < 0.0 || sign * Edge(c, a, u, v) < 0.0 ||
+          sign * Edge(a, b, u, v) < 0.0) {
+        continue;
+      }
+      const double s = RayPlane(camera_vertices_.col(tri[0]), camera_vertices_.col(tri[1]),
+                                camera_vertices_.col(tri[2]), p);
+      occluded = s > 0.0 && s < s_limit;
+    }
+    visible[static_cast<std::size_t>(k)] = !occluded;
+  }
+  return visible;
+}
+
+}  // namespace c3po
