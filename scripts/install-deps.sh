@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs everything c3po needs to build and test on Debian 12 (bookworm).
+# Run as root (or with sudo). Chromium, Node.js and npm are only for the
+# browser tests of the HTML pages; pass --no-browser to skip them.
+set -euo pipefail
+packages=(build-essential cmake ninja-build ccache
+          libeigen3-dev libnanoflann-dev libcli11-dev nlohmann-json3-dev doctest-dev
+          libassimp-dev tiny-dnn)
+if [[ "${1:-}" != "--no-browser" ]]; then
+  packages+=(chromium nodejs npm)
+fi
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${packages[@]}"
