@@ -59,6 +59,8 @@ PointTree::Neighbor PointTree::Nearest(const Eigen::Vector3d& query) const {
   nanoflann::KNNResultSet<double, Eigen::Index> result(1);
   result.init(&neighbor.index, &neighbor.squared_distance);
   index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  // A non-finite (or overflowing) query finds nothing: report it like an empty tree.
+  if (neighbor.index < 0) neighbor.squared_distance = std::numeric_limits<double>::infinity();
   return neighbor;
 }
 

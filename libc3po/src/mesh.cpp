@@ -31,6 +31,9 @@ double TriangleArea(const Mesh& mesh, int t) {
 void AppendAssimpMesh(const aiMesh& source, const aiMatrix4x4& to_root, double scale,
                       std::vector<Eigen::Vector3d>* vertices,
                       std::vector<Eigen::Vector3i>* triangles) {
+  // Point and line meshes (split off by aiProcess_SortByPType) must not add
+  // their vertices: they would enlarge the bounding box and the diameter.
+  if ((source.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) return;
   const int offset = static_cast<int>(vertices->size());
   for (unsigned i = 0; i < source.mNumVertices; ++i) {
     const aiVector3D v = to_root * source.mVertices[i];
@@ -58,6 +61,24 @@ void CollectNode(const aiScene& scene, const aiNode& node, const aiMatrix4x4& pa
   for (unsigned c = 0; c < node.mNumChildren; ++c) {
     CollectNode(scene, *node.mChildren[c], to_root, scale, vertices, triangles, depth + 1);
   }
+}
+
+Eigen::Vector3d ClosestPointOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                      const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  if (!(length2 > 0.0)) return a;
+  return a + std::clamp(ab.dot(p - a) / length2, 0.0, 1.0) * ab;
+}
+
+// A zero-area triangle is the union of its three edges.
+Eigen::Vector3d ClosestPointOnDegenerateTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                                 const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  Eigen::Vector3d best = ClosestPointOnSegment(p, a, b);
+  for (const Eigen::Vector3d& q : {ClosestPointOnSegment(p, b, c), ClosestPointOnSegment(p, c, a)}) {
+    if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
+  }
+  return best;
 }
 
 }  // namespace
@@ -163,6 +184,10 @@ PointSet SampleSurface(const Mesh& mesh, int count, std::uint64_t seed) {
 Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                        const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  // Ericson's divisions assume a proper triangle; zero-area ones would give 0/0.
+  if (!(ab.cross(ac).squaredNorm() > 1e-30 * ab.squaredNorm() * ac.squaredNorm())) {
+    return ClosestPointOnDegenerateTriangle(p, a, b, c);
+  }
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return a;
   const Eigen::Vector3d bp = p - b;
@@ -179,9 +204,10 @@ Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
     return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
   }
-  const double denom = 1.0 / (va + vb + vc);
-  if (!std::isfinite(denom)) return a;  // degenerate (zero-area) triangle
-  return a + ab * (vb * denom) + ac * (vc * denom);
+  // Inside: project onto the plane. Same point as Ericson's a + ab vb/(va+vb+vc)
+  // + ac vc/(va+vb+vc), without the cancellation in va + vb + vc = |ab x ac|^2.
+  const Eigen::Vector3d normal = ab.cross(ac);
+  return p - normal * (normal.dot(ap) / normal.squaredNorm());
 }
 
 SurfacePoint ClosestSurfacePoint(const Mesh& mesh, const Eigen::Vector3d& p) {

@@ -1,6 +1,8 @@
 #include "c3po/registration.hpp"
 
 #include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace c3po {
@@ -59,12 +61,18 @@ RegistrationResult RegisterPoints(const PointSet& model, const PointSet& scene,
 
   const double spread = std::max(model_centred.cwiseAbs().maxCoeff(),
                                  scene_centred.cwiseAbs().maxCoeff());
-  if (spread <= kDistinctTolerance * (1.0 + model_mean.norm() + scene_mean.norm())) {
+  // Max-norms, not Euclidean norms: squaring huge coordinates must not overflow.
+  const double magnitude = model_mean.cwiseAbs().maxCoeff() + scene_mean.cwiseAbs().maxCoeff();
+  if (spread <= kDistinctTolerance * (1.0 + magnitude)) {
     result.status = RegistrationStatus::kTooFewPoints;
     return result;
   }
 
   const Eigen::Matrix3d M = scene_centred * w.asDiagonal() * model_centred.transpose();
+  if (!M.allFinite()) {  // coordinates too large to square
+    result.status = RegistrationStatus::kNonFinite;
+    return result;
+  }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
   result.singular_values = svd.singularValues();
   if (result.singular_values(1) <= kCollinearTolerance * result.singular_values(0)) {
