@@ -1,8 +1,128 @@
-// c3po bench
+// c3po bench: speed and accuracy figures of components, printed as tables
+// (and JSON with --json FILE). Benchmarks are commands, never timed tests.
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "bench_registry.hpp"
+#include "c3po/atomic_file.hpp"
+#include "c3po/corrector_benchmark.hpp"
+#include "c3po/dataset.hpp"
+#include "c3po/error.hpp"
+#include "c3po/object_io.hpp"
 #include "command.hpp"
+#include "common.hpp"
 
 namespace c3po::cli {
+namespace {
 
-RunFunction SetupBench(CLI::App& command) { return NotBuiltYet(command, "Objects and data"); }
+struct CorrectorBenchCommand {
+  std::string object_path;
+  std::string data_dir;
+  std::string sigmas = "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1.0";
+  double fraction = 0.8;
+  std::string solvers = "fast";
+  std::string loss = "mean";
+  std::string eps_oc_text;
+  std::uint64_t seed = 0;
+  int threads = 1;
+  int max_clouds = 0;
+  std::string json_path;
+};
+
+std::vector<double> ParseNumberList(const std::string& text, const std::string& what) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0') throw InputError(what, "'" + item + "' is not a number");
+    values.push_back(value);
+  }
+  if (values.empty()) throw InputError(what, "empty list");
+  return values;
+}
+
+int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
+  const ObjectModel object = LoadObject(cmd.object_path);
+  const Dataset dataset = ReadDataset(cmd.data_dir);
+  CorrectorBenchmarkOptions options;
+  options.sigmas = ParseNumberList(cmd.sigmas, "--sigma");
+  options.fraction = cmd.fraction;
+  options.solvers.clear();
+  std::stringstream solver_list(cmd.solvers);
+  for (std::string name; std::getline(solver_list, name, ',');) options.solvers.push_back(ParseCorrectorSolver(name));
+  options.corrector.loss = ParsePointCloudLoss(cmd.loss);
+  options.certificate = CertificateOptions::FromObject(object.spec());
+  if (!cmd.eps_oc_text.empty()) options.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
+  options.seed = cmd.seed;
+  options.threads = cmd.threads;
+  options.max_clouds = cmd.max_clouds;
+  try {
+    options.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("c3po bench corrector", e.what());
+  }
+  ProgressBar progress("corrector", 1);
+  const auto rows = RunCorrectorBenchmark(object, dataset, options, [&](std::size_t done, std::size_t total) {
+    progress.Update(done * 1000 / std::max<std::size_t>(total, 1) / 1000);
+  });
+  progress.Finish();
+  std::printf("corrector analysis: %s, %d clouds, %.0f%% of keypoints perturbed by U[-sigma d/2, sigma d/2], "
+              "d = %.4g, eps_oc = %.4g, loss = %s, %d thread(s)\n",
+              object.name().c_str(), rows.empty() ? 0 : rows[0].clouds, 100 * options.fraction,
+              object.diameter(), options.certificate.eps_oc, ToString(options.corrector.loss), options.threads);
+  std::printf("%6s  %-18s %9s %9s %9s %9s %9s %7s %8s %8s %7s\n", "sigma", "method", "rot med", "rot mean",
+              "t/d med", "t/d mean", "ADD-S/d", "% oc", "ms med", "ms mean", "iters");
+  nlohmann::json json = nlohmann::json::array();
+  for (const auto& row : rows) {
+    std::printf("%6.2f  %-18s %8.2f° %8.2f° %9.4f %9.4f %9.4f %7.1f %8.3f %8.3f %7.1f\n", row.sigma,
+                row.method.c_str(), row.median_rotation_deg, row.mean_rotation_deg,
+                row.median_translation_over_d, row.mean_translation_over_d, row.median_adds_over_d,
+                row.percent_oc, row.median_ms, row.mean_ms, row.mean_iterations);
+    json.push_back({{"sigma", row.sigma}, {"method", row.method}, {"clouds", row.clouds},
+                    {"median_rotation_deg", row.median_rotation_deg}, {"mean_rotation_deg", row.mean_rotation_deg},
+                    {"median_translation_over_d", row.median_translation_over_d},
+                    {"mean_translation_over_d", row.mean_translation_over_d},
+                    {"median_adds_over_d", row.median_adds_over_d}, {"percent_oc", row.percent_oc},
+                    {"median_ms", row.median_ms}, {"mean_ms", row.mean_ms},
+                    {"mean_iterations", row.mean_iterations}});
+  }
+  if (!cmd.json_path.empty()) WriteFileAtomically(cmd.json_path, json.dump(2) + "\n");
+  return 0;
+}
+
+void SetupCorrectorBench(CLI::App& parent, std::function<int()>* run) {
+  auto cmd = std::make_shared<CorrectorBenchCommand>();
+  CLI::App* sub = parent.add_subcommand("corrector", "The paper's corrector analysis on a depth dataset");
+  sub->add_option("object", cmd->object_path, "Object JSON")->required();
+  sub->add_option("--data", cmd->data_dir, "Dataset with ground truth (c3po synth)")->required();
+  sub->add_option("--sigma", cmd->sigmas, "Comma-separated noise levels sigma (fraction of d)");
+  sub->add_option("--fraction", cmd->fraction, "Probability that a keypoint is perturbed");
+  sub->add_option("--solvers", cmd->solvers, "Corrector solvers to compare: fast,gd");
+  sub->add_option("--loss", cmd->loss, "Point-cloud loss: mean or max");
+  sub->add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold (default: object's)");
+  sub->add_option("--seed", cmd->seed, "Seed of the perturbations");
+  sub->add_option("--threads", cmd->threads, "Worker threads (1 gives honest per-cloud times)");
+  sub->add_option("--max-clouds", cmd->max_clouds, "Use at most this many clouds (0 = all)");
+  sub->add_option("--json", cmd->json_path, "Also write the rows as JSON to this file");
+  sub->footer("Example:\n  c3po bench corrector drill.json --data data/drill_depth --sigma 0.1,0.3,0.5 --solvers fast,gd");
+  sub->callback([cmd, run]() { *run = [cmd]() { return RunCorrectorBench(*cmd); }; });
+}
+
+}  // namespace
+
+RunFunction SetupBench(CLI::App& command) {
+  auto run = std::make_shared<std::function<int()>>();
+  command.require_subcommand(1);
+  SetupCorrectorBench(command, run.get());
+  for (const auto& entry : BenchEntries()) entry.setup(command, run.get());
+  return [run]() {
+    if (!*run) throw InputError("c3po bench", "choose a benchmark");
+    return (*run)();
+  };
+}
 
 }  // namespace c3po::cli
