@@ -170,7 +170,7 @@ std::pair<std::size_t, const char*> KeypointCount(const DatasetEntry& entry, con
                        " has " + std::to_string(count));
     }
     count = n;
-    source = field;
+    if (!source) source = field;
   };
   if (entry.keypoints) agree(static_cast<std::size_t>(entry.keypoints->cols()), "keypoints");
   if (entry.detected_keypoints) agree(static_cast<std::size_t>(entry.detected_keypoints->cols()), "detected_keypoints");
@@ -227,7 +227,7 @@ DatasetEntry ParseManifestLine(const std::string& line, const std::string& where
   nlohmann::json object;
   try {
     object = nlohmann::json::parse(line);
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const nlohmann::json::exception& error) {   // parse_error, number overflow
     std::string message = error.what();
     const std::size_t bracket = message.find("] ");
     if (bracket != std::string::npos) message = message.substr(bracket + 2);
