@@ -1,8 +1,19 @@
-// The detectors compiled into c3po.
+// The detectors compiled into c3po: one registration per built-in detector.
 #include "registry_internal.hpp"
+
+#ifdef C3PO_HAVE_SVD
+#include "c3po/plugins/svd_detector.hpp"
+#endif
 
 namespace c3po {
 
-void RegisterBuiltinDetectors() {}
+void RegisterBuiltinDetectors() {
+#ifdef C3PO_HAVE_SVD
+  RegisterDetector({"svd", "principal-axes hypotheses refined by ICP (no training)", false},
+                   [](const ObjectModel& object) -> std::unique_ptr<Detector> {
+                     return std::make_unique<SvdDetector>(object);
+                   });
+#endif
+}
 
 }  // namespace c3po
