@@ -61,6 +61,9 @@ void LoadPlugin(const std::string& path) {
   if (!table->name || !*table->name || !table->create || !table->detect) {
     throw InputError(path, "plugin table lacks a name, create or detect");
   }
+  // Built-ins register lazily on first registry use; do it now, or they would
+  // later silently replace a plugin of the same name (the plugin must win).
+  (void)ListDetectors();
   DetectorInfo info{table->name, table->description ? table->description : "plugin", false};
   info.description += " (plugin " + path + ")";
   RegisterDetector(info, [table, path](const ObjectModel& object) -> std::unique_ptr<Detector> {
