@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -49,6 +50,28 @@ T Required(const json& doc, const char* key, const std::string& where) {
   }
 }
 
+// Indices must be JSON integers (1.5 or 1e20 must not be truncated silently);
+// ObjectSpec::Validate checks the range against the keypoint count.
+std::vector<std::vector<int>> ParseIndicatorSets(const json& value, const std::string& where) {
+  const std::string field = "indicator_sets";
+  if (!value.is_array()) throw InputError(where, field + ": expected a list of lists of keypoint indices");
+  std::vector<std::vector<int>> sets;
+  for (std::size_t s = 0; s < value.size(); ++s) {
+    const std::string name = field + "[" + std::to_string(s) + "]";
+    if (!value[s].is_array()) throw InputError(where, name + ": expected a list of keypoint indices");
+    std::vector<int> set;
+    for (const json& index : value[s]) {
+      if (!index.is_number_integer()) throw InputError(where, name + ": keypoint index " + index.dump() + " is not an integer");
+      const bool fits = index.is_number_unsigned() ? index.get<std::uint64_t>() <= 1000000000ULL
+                                                   : std::llabs(index.get<std::int64_t>()) <= 1000000000LL;
+      if (!fits) throw InputError(where, name + ": keypoint index " + index.dump() + " out of range");
+      set.push_back(index.get<int>());
+    }
+    sets.push_back(std::move(set));
+  }
+  return sets;
+}
+
 json PointListJson(const PointSet& points) {
   json list = json::array();
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
@@ -66,6 +89,8 @@ ObjectSpec ReadObjectSpec(const std::string& path) {
     doc = json::parse(text);
   } catch (const json::parse_error& e) {
     throw InputError(path, std::string("not valid JSON (byte ") + std::to_string(e.byte) + ")");
+  } catch (const json::exception& e) {  // e.g. out_of_range.406: a number like 1e400
+    throw InputError(path, std::string("not valid JSON: ") + e.what());
   }
   if (!doc.is_object()) throw InputError(path, "expected a JSON object");
   ObjectSpec spec;
@@ -84,7 +109,7 @@ ObjectSpec ReadObjectSpec(const std::string& path) {
     spec.keypoint_names = Required<std::vector<std::string>>(doc, "keypoint_names", path);
   }
   if (doc.contains("indicator_sets")) {
-    spec.indicator_sets = Required<std::vector<std::vector<int>>>(doc, "indicator_sets", path);
+    spec.indicator_sets = ParseIndicatorSets(doc["indicator_sets"], path);
   }
   spec.eps_oc = Required<double>(doc, "eps_oc", path);
   spec.delta_nd = Required<double>(doc, "delta_nd", path);

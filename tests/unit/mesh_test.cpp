@@ -154,7 +154,7 @@ void CheckLoadFails(const std::string& path) {
   CAPTURE(path);
   try {
     c3po::LoadMesh(path);
-    FAIL("LoadMesh accepted " << path);
+    FAIL_CHECK("LoadMesh accepted " << path);
   } catch (const c3po::InputError& e) {
     const std::string message = e.what();
     CAPTURE(message);
