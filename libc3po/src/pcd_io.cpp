@@ -65,6 +65,7 @@ class PcdHeaderParser {
       const std::string_view content = Trim(line);
       if (content.empty() || content.front() == '#') continue;
       const std::vector<std::string_view> tokens = SplitTokens(content);
+      if (tokens.empty()) continue;
       const std::string keyword = Upper(tokens[0]);
       if (keyword == "DATA") {
         ParseData(tokens);

@@ -382,6 +382,8 @@ TEST_CASE("malformed PCD and XYZ files give InputErrors naming the file") {
   CHECK(ParseError("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F X\nPOINTS 1\nDATA ascii\n1 2 3\n", CloudFormat::kPcd, "n.pcd") ==
         "n.pcd: line 6: field 'z': unsupported TYPE 'X' with SIZE 4");
   CHECK(ParseError("garbage", CloudFormat::kPcd, "g.pcd") == "g.pcd: line 1: unknown header keyword 'garbage'");
+  // Found by fuzzing: a header line of only a vertical tab.
+  CHECK(ParseError("\v", CloudFormat::kPcd, "v.pcd") == "v.pcd: not a PCD file (no DATA line in the header)");
 
   CHECK(ParseError("1 2 3\n4 5\n", CloudFormat::kXyz, "cloud.xyz") == "cloud.xyz: line 2: expected 3 coordinates, found 2");
   CHECK(ParseError("1 2 3\n4 5 inf\n", CloudFormat::kXyz, "cloud.xyz") == "cloud.xyz: line 2: point 1: non-finite coordinate");
