@@ -8,8 +8,11 @@
 #include "asymmetric_object.hpp"
 #include "c3po/error.hpp"
 #include "c3po/metrics.hpp"
+#include "c3po/object_io.hpp"
 #include "c3po/plugins/svd_detector.hpp"
 #include "c3po/random.hpp"
+#include "c3po/render.hpp"
+#include "test_helpers.hpp"
 
 using namespace c3po;
 
@@ -105,6 +108,30 @@ TEST_CASE("svd detector recovers the pose from camera-facing partial clouds") {
     const PointSet keypoints = detector.Detect(cloud);
     CHECK(MaxKeypointError(keypoints, truth * object.keypoints()) < 0.02 * d);
   }
+}
+
+TEST_CASE("svd detector on rendered depth clouds of the bundled drill (1 mm noise)") {
+  const ObjectModel object = LoadObject(test::SourceDir() + "/annotations/drill.json");
+  const SvdDetector detector(object);
+  const double d = object.diameter();
+  DepthRenderer renderer{CameraIntrinsics()};
+  DepthSampleOptions sampling;
+  sampling.points = 1000;
+  sampling.noise_sigma = 0.001;
+  int within = 0;
+  const int count = 10;
+  for (int i = 0; i < count; ++i) {
+    Rng rng = Rng::ForItem(5, i);
+    const Pose truth{rng.Rotation(), Eigen::Vector3d(rng.Uniform(-0.05, 0.05), rng.Uniform(-0.05, 0.05),
+                                                     rng.Uniform(0.5, 0.8))};
+    renderer.Render(object.mesh(), truth);
+    const PointSet cloud = renderer.SampleCloud(sampling, rng);
+    REQUIRE(cloud.cols() > 100);
+    const SvdEstimate estimate = detector.Estimate(cloud);
+    if (AddS(object.tree(), truth, estimate.scene_from_model) < 0.05 * d) ++within;
+  }
+  MESSAGE(within << " of " << count << " drill depth clouds with ADD-S below 5 % d");
+  CHECK(within >= count - 1);
 }
 
 TEST_CASE("svd detector on half clouds gives finite keypoints and honest evidence") {
