@@ -3,8 +3,11 @@
 #include "c3po/render.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <sstream>
 #include <vector>
 
@@ -96,10 +99,96 @@ void DepthRenderer::ClearRectangle() {
   rect_u1_ = rect_v1_ = -1;
 }
 
-void DepthRenderer::Render(const Mesh& mesh, const Pose& camera_from_model) {
+bool IsClosedOutward(const Mesh& mesh) {
+  if (mesh.empty()) return false;
+  // Vertices are identified by position (loaders split vertices at texture
+  // seams); zero-area triangles are never drawn and are skipped.
+  std::vector<int> order(static_cast<std::size_t>(mesh.vertices.cols()));
+  std::iota(order.begin(), order.end(), 0);
+  const auto less = [&](int i, int j) {
+    const auto a = mesh.vertices.col(i), b = mesh.vertices.col(j);
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  };
+  std::sort(order.begin(), order.end(), less);
+  std::vector<std::uint32_t> canonical(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const bool same = k > 0 && !less(order[k - 1], order[k]);
+    canonical[static_cast<std::size_t>(order[k])] =
+        same ? canonical[static_cast<std::size_t>(order[k - 1])] : static_cast<std::uint32_t>(k);
+  }
+  // Triangles by sorted vertex ids and winding; a triangle coincident with a
+  // reversed copy of itself (a zero-thickness fin) is drawn either way and is
+  // left out, like zero-area triangles.
+  struct Face {
+    std::array<std::uint32_t, 3> sorted;
+    bool even;   // winding parity relative to the sorted order
+    std::array<std::uint32_t, 3> id;
+    bool operator<(const Face& o) const {
+      return sorted != o.sorted ? sorted < o.sorted : even < o.even;
+    }
+  };
+  std::vector<Face> faces;
+  for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
+    Face face;
+    for (int e = 0; e < 3; ++e) {
+      face.id[static_cast<std::size_t>(e)] = canonical[static_cast<std::size_t>(mesh.triangles(e, t))];
+    }
+    const auto& id = face.id;
+    if (id[0] == id[1] || id[1] == id[2] || id[0] == id[2]) continue;
+    const Eigen::Vector3d a = mesh.vertices.col(mesh.triangles(0, t));
+    if ((Eigen::Vector3d(mesh.vertices.col(mesh.triangles(1, t))) - a)
+            .cross(Eigen::Vector3d(mesh.vertices.col(mesh.triangles(2, t))) - a)
+            .squaredNorm() == 0.0) {
+      continue;
+    }
+    face.sorted = id;
+    std::sort(face.sorted.begin(), face.sorted.end());
+    // A rotation of the sorted triple has even parity.
+    face.even = (id[0] == face.sorted[0] && id[1] == face.sorted[1]) ||
+                (id[1] == face.sorted[0] && id[2] == face.sorted[1]) ||
+                (id[2] == face.sorted[0] && id[0] == face.sorted[1]);
+    faces.push_back(face);
+  }
+  std::sort(faces.begin(), faces.end());
+  // Directed edges: closed and consistent iff every directed edge occurs once
+  // and its reverse occurs too.
+  std::vector<std::uint64_t> edges;
+  edges.reserve(faces.size() * 3);
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const bool fin = (f + 1 < faces.size() && faces[f + 1].sorted == faces[f].sorted) ||
+                     (f > 0 && faces[f - 1].sorted == faces[f].sorted);
+    if (fin && ((f + 1 < faces.size() && faces[f + 1].even != faces[f].even) ||
+                (f > 0 && faces[f - 1].even != faces[f].even))) {
+      continue;
+    }
+    const auto& id = faces[f].id;
+    for (std::size_t e = 0; e < 3; ++e) {
+      edges.push_back((static_cast<std::uint64_t>(id[e]) << 32) | id[(e + 1) % 3]);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  if (std::adjacent_find(edges.begin(), edges.end()) != edges.end()) return false;
+  for (const std::uint64_t edge : edges) {
+    const std::uint64_t reverse = (edge << 32) | (edge >> 32);
+    if (!std::binary_search(edges.begin(), edges.end(), reverse)) return false;
+  }
+  double six_volume = 0.0;
+  for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
+    const Eigen::Vector3d a = mesh.vertices.col(mesh.triangles(0, t));
+    six_volume += a.dot(Eigen::Vector3d(mesh.vertices.col(mesh.triangles(1, t)))
+                            .cross(Eigen::Vector3d(mesh.vertices.col(mesh.triangles(2, t)))));
+  }
+  return six_volume > 0.0;
+}
+
+void DepthRenderer::Render(const Mesh& mesh, const Pose& camera_from_model,
+                           bool cull_back_faces) {
   ClearRectangle();
   covered_.clear();
   triangles_ = &mesh.triangles;
+  cull_back_faces_ = cull_back_faces;
+  screen_area_.assign(static_cast<std::size_t>(mesh.triangles.cols()),
+                      std::numeric_limits<double>::quiet_NaN());
   camera_vertices_ = camera_from_model * mesh.vertices;
   const Eigen::Index count = camera_vertices_.cols();
   projected_.resize(2, count);
@@ -144,9 +233,10 @@ void DepthRenderer::RasterizeTriangle(int t) {
   const Eigen::Vector2d a = projected_.col(tri[0]);
   const Eigen::Vector2d b = projected_.col(tri[1]);
   const Eigen::Vector2d c = projected_.col(tri[2]);
-  if (!(a.allFinite() && b.allFinite() && c.allFinite())) return;   // behind the near plane
   double area = Edge(a, b, c.x(), c.y());
-  if (area == 0.0) return;
+  screen_area_[static_cast<std::size_t>(t)] = area;
+  // NaN (behind the near plane), edge-on, or culled back face.
+  if (!(area < 0.0 || (area > 0.0 && !cull_back_faces_))) return;
   const double u_lo = std::max<double>(rect_u0_, std::ceil(std::min({a.x(), b.x(), c.x()})));
   const double u_hi = std::min<double>(rect_u1_, std::floor(std::max({a.x(), b.x(), c.x()})));
   const double v_lo = std::max<double>(rect_v0_, std::ceil(std::min({a.y(), b.y(), c.y()})));
@@ -231,39 +321,49 @@ PointSet DepthRenderer::SampleCloud(const DepthSampleOptions& options, Rng& rng,
 
 std::vector<bool> DepthRenderer::KeypointsVisible(const PointSet& camera_keypoints,
                                                   double tolerance) const {
-  std::vector<bool> visible(static_cast<std::size_t>(camera_keypoints.cols()), false);
+  const std::size_t count = static_cast<std::size_t>(camera_keypoints.cols());
+  std::vector<bool> visible(count, false);
   if (!triangles_) return visible;
-  for (Eigen::Index k = 0; k < camera_keypoints.cols(); ++k) {
-    const Eigen::Vector3d p = camera_keypoints.col(k);
+  // Keypoints to test: in front of the camera and inside the image.
+  struct Query {
+    std::size_t index;
+    double u, v;
+    double s_limit;   // occluded by a hit at ray parameter s in (0, s_limit)
+    bool occluded;
+  };
+  std::vector<Query> queries;
+  for (std::size_t k = 0; k < count; ++k) {
+    const Eigen::Vector3d p = camera_keypoints.col(static_cast<Eigen::Index>(k));
     if (!(p.z() > kNearPlane)) continue;
     const double u = camera_.fx * p.x() / p.z() + camera_.cx;
     const double v = camera_.fy * p.y() / p.z() + camera_.cy;
     if (!(u >= -0.5 && u < camera_.width - 0.5 && v >= -0.5 && v < camera_.height - 0.5)) continue;
-    // Occluded when a triangle meets the ray s * p at s < 1 - tolerance / |p|.
-    const double s_limit = 1.0 - tolerance / p.norm();
-    bool occluded = false;
-    for (Eigen::Index t = 0; t < triangles_->cols() && !occluded; ++t) {
-      const Eigen::Vector3i tri = triangles_->col(t);
-      const Eigen::Vector2d a = projected_.col(tri[0]);
-      const Eigen::Vector2d b = projected_.col(tri[1]);
-      const Eigen::Vector2d c = projected_.col(tri[2]);
-      if (!(std::min({a.x(), b.x(), c.x()}) <= u && std::max({a.x(), b.x(), c.x()}) >= u &&
-            std::min({a.y(), b.y(), c.y()}) <= v && std::max({a.y(), b.y(), c.y()}) >= v)) {
-        continue;
-      }
-      if (!(a.allFinite() && b.allFinite() && c.allFinite())) continue;   // behind the camera
-      const double area = Edge(a, b, c.x(), c.y());
-      const double sign = area >= 0.0 ? 1.0 : -1.0;
-      if (sign * Edge(b, c, u, v) < 0.0 || sign * Edge(c, a, u, v) < 0.0 ||
-          sign * Edge(a, b, u, v) < 0.0) {
+    queries.push_back({k, u, v, 1.0 - tolerance / p.norm(), false});
+  }
+  if (queries.empty() || screen_area_.empty()) return visible;
+  for (Eigen::Index t = 0; t < triangles_->cols(); ++t) {
+    const double area = screen_area_[static_cast<std::size_t>(t)];
+    if (!(area < 0.0 || (area > 0.0 && !cull_back_faces_))) continue;
+    const Eigen::Vector3i tri = triangles_->col(t);
+    const Eigen::Vector2d a = projected_.col(tri[0]);
+    const Eigen::Vector2d b = projected_.col(tri[1]);
+    const Eigen::Vector2d c = projected_.col(tri[2]);
+    const double u_lo = std::min({a.x(), b.x(), c.x()}), u_hi = std::max({a.x(), b.x(), c.x()});
+    const double v_lo = std::min({a.y(), b.y(), c.y()}), v_hi = std::max({a.y(), b.y(), c.y()});
+    const double sign = area > 0.0 ? 1.0 : -1.0;
+    for (Query& q : queries) {
+      if (q.occluded || q.u < u_lo || q.u > u_hi || q.v < v_lo || q.v > v_hi) continue;
+      if (sign * Edge(b, c, q.u, q.v) < 0.0 || sign * Edge(c, a, q.u, q.v) < 0.0 ||
+          sign * Edge(a, b, q.u, q.v) < 0.0) {
         continue;
       }
       const double s = RayPlane(camera_vertices_.col(tri[0]), camera_vertices_.col(tri[1]),
-                                camera_vertices_.col(tri[2]), p);
-      occluded = s > 0.0 && s < s_limit;
+                                camera_vertices_.col(tri[2]),
+                                camera_keypoints.col(static_cast<Eigen::Index>(q.index)));
+      q.occluded = s > 0.0 && s < q.s_limit;
     }
-    visible[static_cast<std::size_t>(k)] = !occluded;
   }
+  for (const Query& q : queries) visible[q.index] = !q.occluded;
   return visible;
 }
 
