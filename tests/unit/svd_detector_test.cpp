@@ -13,6 +13,8 @@
 #include "c3po/random.hpp"
 #include "c3po/render.hpp"
 #include "test_helpers.hpp"
+// Internal to the svd plugin (linked through c3po::plugins).
+#include "../../plugins/svd/src/distance_grid.hpp"
 
 using namespace c3po;
 
@@ -155,6 +157,32 @@ TEST_CASE("svd detector on half clouds gives finite keypoints and honest evidenc
   // A cut through the centroid removes much of the shape: the one-sided fit
   // is then often ambiguous. Reported, not asserted.
   MESSAGE(recovered << " of 6 half clouds gave keypoints within 5 % d of the truth");
+}
+
+TEST_CASE("the screening distance field agrees with brute-force nearest distances") {
+  const ObjectModel object = test::AsymmetricObject(2000);
+  const DistanceGrid grid(object.tree(), 30, 0.1);
+  const PointSet& sample = object.sample();
+  Rng rng(17);
+  const Eigen::AlignedBox3d box = grid.box();
+  // Trilinear interpolation of a 1-Lipschitz function: error <= step * sqrt(3).
+  const double tolerance = grid.step() * std::sqrt(3.0);
+  int outside = 0;
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3d p = box.center() + 0.75 * (box.sizes().array() *
+                              Eigen::Array3d(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1))).matrix();
+    const double truth = std::sqrt((sample.colwise() - p).colwise().squaredNorm().minCoeff());
+    const double estimate = grid.Distance(p);
+    if (box.contains(p)) {
+      CHECK(std::abs(estimate - truth) <= tolerance);
+    } else {
+      ++outside;   // clamped: never below the truth by more than the tolerance
+      CHECK(estimate >= truth - tolerance);
+    }
+  }
+  CHECK(outside > 50);
+  PointSet queries = sample.leftCols(10);
+  CHECK(grid.MeanSquaredDistance(queries) <= tolerance * tolerance);
 }
 
 TEST_CASE("hypotheses are the 24 (or 4) proper rotations mapping model axes onto signed cloud axes") {

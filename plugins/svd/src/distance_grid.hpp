@@ -22,6 +22,11 @@ class DistanceGrid {
   // Mean of squared approximate distances over the columns of `queries`.
   double MeanSquaredDistance(const PointSet& queries) const;
 
+  double step() const { return step_; }   // node spacing
+  Eigen::AlignedBox3d box() const {       // region covered by the nodes
+    return {origin_, origin_ + step_ * (size_ - Eigen::Vector3i::Ones()).cast<double>()};
+  }
+
  private:
   double Node(int i, int j, int k) const { return values_[(k * size_.y() + j) * size_.x() + i]; }
 

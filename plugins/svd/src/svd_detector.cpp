@@ -15,6 +15,9 @@
 namespace c3po {
 namespace {
 
+// Cloud subsample that measures the cloud's extent for box-aligned translations.
+constexpr int kExtentPoints = 2000;
+
 PointSet FiniteColumns(const PointSet& points) {
   std::vector<Eigen::Index> keep;
   keep.reserve(points.cols());
@@ -136,13 +139,14 @@ std::vector<SvdDetector::Candidate> SvdDetector::Screen(const PointSet& points,
       PrincipalAxisRotations(model_axes_, PrincipalAxes(points, centroid), options_.try_permutations);
   rotations.insert(rotations.end(), uniform_rotations_.begin(), uniform_rotations_.end());
   const PointSet screening = Subsample(points, options_.screening_points, options_.seed + 2);
+  const PointSet extent_points = Subsample(points, kExtentPoints, options_.seed + 3);
   const int choices = options_.box_translations ? 3 : 1;
 
   std::vector<Candidate> candidates;
   for (const Eigen::Matrix3d& R : rotations) {
     // Model-frame offsets s (t = R s): per axis, centroids match, or the
     // cloud's extent starts at the model box's low end, or ends at its high end.
-    const PointSet rotated = R.transpose() * points;
+    const PointSet rotated = R.transpose() * extent_points;
     const Eigen::Vector3d lows = rotated.rowwise().minCoeff(), highs = rotated.rowwise().maxCoeff();
     const Eigen::Vector3d centred = R.transpose() * centroid - model_centroid_;
     const Eigen::Matrix3d offsets = (Eigen::Matrix3d() << centred, lows - model_box_.min(),
