@@ -94,28 +94,28 @@ void SyncFolder(const std::string& folder) {
 }
 
 // Writes through `write`, returns 0 or the errno of the first failure.
-int WriteAndSync(int fd, const std::function<void(std::ostream&)>& write) {
+int WriteAndSync(int fd, const std::function<void(std::ostream&)>& write, bool sync) {
   FdStreamBuf buffer(fd);
   std::ostream stream(&buffer);
   write(stream);
   stream.flush();
   if (buffer.error() != 0) return buffer.error();
   if (!stream) return EIO;
-  if (::fsync(fd) != 0) return errno;
+  if (sync && ::fsync(fd) != 0) return errno;
   return 0;
 }
 
 }  // namespace
 
 void WriteFileAtomically(const std::string& path,
-                         const std::function<void(std::ostream&)>& write) {
+                         const std::function<void(std::ostream&)>& write, bool sync) {
   if (path.empty() || path.back() == '/') throw InputError(path, "cannot write: not a file name");
   const std::string temporary = TemporarySibling(path);
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) Fail(path, errno);
   int error = 0;
   try {
-    error = WriteAndSync(fd, write);
+    error = WriteAndSync(fd, write, sync);
   } catch (...) {
     ::close(fd);
     ::unlink(temporary.c_str());
@@ -127,7 +127,7 @@ void WriteFileAtomically(const std::string& path,
     ::unlink(temporary.c_str());
     Fail(path, error);
   }
-  SyncFolder(ParentOf(path));
+  if (sync) SyncFolder(ParentOf(path));
 }
 
 void WriteFileAtomically(const std::string& path, const std::string& contents) {

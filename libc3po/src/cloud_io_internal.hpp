@@ -70,6 +70,9 @@ PointSet ParsePly(std::string_view bytes, const std::string& name);
 PointSet ParsePcd(std::string_view bytes, const std::string& name);
 PointSet ParseXyz(std::string_view bytes, const std::string& name);
 
+// WritePly with a choice of fsync (see WriteFileAtomically).
+void WritePlyBinary(const std::string& path, const PointSet& points, bool sync);
+
 // Encoding helpers for writers.
 void AppendFloat32LE(std::string* out, float value);
 std::string FormatDouble(double value);   // shortest text that reads back exactly

@@ -4,6 +4,7 @@
 // dataset.
 #include "c3po/dataset.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <Eigen/SVD>
@@ -17,6 +18,7 @@
 #include "c3po/atomic_file.hpp"
 #include "c3po/cloud_io.hpp"
 #include "c3po/error.hpp"
+#include "cloud_io_internal.hpp"
 
 namespace c3po {
 namespace fs = std::filesystem;
@@ -206,6 +208,16 @@ void CheckReplaceable(const std::string& dir) {
   throw InputError(dir, "exists and is not a c3po dataset (no manifest.jsonl); refusing to overwrite it");
 }
 
+// Flushes every file of the folder's file system to disk (one syncfs instead
+// of an fsync per cloud) and records the folder entries.
+void SyncFileSystemOf(const std::string& folder) {
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::syncfs(fd);
+  ::fsync(fd);
+  ::close(fd);
+}
+
 [[noreturn]] void FailWrite(const std::string& path, const std::error_code& ec) {
   throw InputError(path, "cannot write: " + ec.message());
 }
@@ -349,7 +361,7 @@ void DatasetWriter::Add(std::size_t order, const DatasetEntry& entry, const Poin
     fs::create_directories(ParentOf(path), ec);
     if (ec) FailWrite(path, ec);
   }
-  WritePly(path, cloud);
+  cloud_detail::WritePlyBinary(path, cloud, false);   // synced once by Commit
   const std::lock_guard<std::mutex> lock(mutex_);
   lines_.emplace_back(order, std::move(line));
 }
@@ -363,6 +375,7 @@ void DatasetWriter::Commit() {
   std::string manifest;
   for (const auto& [order, line] : lines_) manifest += line + "\n";
   WriteFileAtomically(tmp_dir_ + "/manifest.jsonl", manifest);
+  SyncFileSystemOf(tmp_dir_);   // the clouds were written without fsync
 
   CheckReplaceable(dir_);
   std::error_code ec;
@@ -383,6 +396,7 @@ void DatasetWriter::Commit() {
     fs::rename(tmp_dir_, dir_, ec);   // also replaces an empty folder
     if (ec) FailWrite(dir_, ec);
   }
+  SyncFileSystemOf(ParentOf(dir_));   // make the renames durable
   committed_ = true;
 }
 

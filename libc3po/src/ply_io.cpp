@@ -421,23 +421,27 @@ PointSet ParsePly(std::string_view bytes, const std::string& name) {
   return PlyBinaryReader(bytes, header, name).Read();
 }
 
-}  // namespace cloud_detail
-
-void WritePly(const std::string& path, const PointSet& points) {
-  cloud_detail::CheckWritable(path, points, true);
+void WritePlyBinary(const std::string& path, const PointSet& points, bool sync) {
+  CheckWritable(path, points, true);
   WriteFileAtomically(path, [&points](std::ostream& out) {
-    out << cloud_detail::PlyHeaderText("binary_little_endian", "float", points.cols());
+    out << PlyHeaderText("binary_little_endian", "float", points.cols());
     constexpr Eigen::Index kChunk = 1 << 14;
     std::string buffer;
     for (Eigen::Index start = 0; start < points.cols(); start += kChunk) {
       buffer.clear();
       const Eigen::Index end = std::min(points.cols(), start + kChunk);
       for (Eigen::Index i = start; i < end; ++i) {
-        for (int k = 0; k < 3; ++k) cloud_detail::AppendFloat32LE(&buffer, static_cast<float>(points(k, i)));
+        for (int k = 0; k < 3; ++k) AppendFloat32LE(&buffer, static_cast<float>(points(k, i)));
       }
       out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
     }
-  });
+  }, sync);
+}
+
+}  // namespace cloud_detail
+
+void WritePly(const std::string& path, const PointSet& points) {
+  cloud_detail::WritePlyBinary(path, points, true);
 }
 
 void WritePlyAscii(const std::string& path, const PointSet& points) {

@@ -10,10 +10,12 @@
 namespace c3po {
 
 // Calls `write` on a binary stream to a temporary sibling of `path`, checks the
-// stream, flushes to disk and renames. Throws InputError("path: cannot write:
-// reason") on failure (the temporary file is removed).
+// stream, flushes to disk (fsync) and renames. Throws InputError("path: cannot
+// write: reason") on failure (the temporary file is removed). `sync = false`
+// skips the fsync, for files inside a folder that is itself published
+// atomically and synced once (DatasetWriter).
 void WriteFileAtomically(const std::string& path,
-                         const std::function<void(std::ostream&)>& write);
+                         const std::function<void(std::ostream&)>& write, bool sync = true);
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
 // Reads a whole file; throws InputError("path: cannot read: reason").
