@@ -27,6 +27,26 @@ struct TrainingSample {
   PointSet keypoints;
 };
 
+// A detector that can be trained by regression onto target keypoints (used by
+// supervised training and by self-training on pseudo-labels).
+class TrainableDetector : public Detector {
+ public:
+  // One optimiser step on a batch; returns the batch's mean squared keypoint
+  // error before the step. clouds.size() == targets.size() > 0.
+  virtual double TrainStep(const std::vector<PointSet>& clouds,
+                           const std::vector<PointSet>& targets) = 0;
+  // Parameters only (for keeping the best epoch in memory).
+  virtual std::vector<float> GetWeights() const = 0;
+  virtual void SetWeights(const std::vector<float>& weights) = 0;
+  // Model file (self-describing, atomic). `header_extra` is merged into the
+  // file's JSON header (e.g. {"selftrained": true}).
+  virtual void Save(const std::string& path, const std::string& header_extra_json = "") const = 0;
+  // Checkpoint = model + optimiser state + `state_json` (epoch, counters).
+  virtual void SaveCheckpoint(const std::string& path, const std::string& state_json) const = 0;
+  // Restores model + optimiser state; returns the state_json saved with it.
+  virtual std::string LoadCheckpoint(const std::string& path) = 0;
+};
+
 using ProgressCallback = std::function<void(std::size_t done, std::size_t total)>;
 
 }  // namespace c3po
