@@ -93,6 +93,12 @@ bool LineReader::Next(std::string_view* line) {
 
 std::vector<std::string_view> SplitTokens(std::string_view line, bool commas) {
   std::vector<std::string_view> tokens;
+  SplitTokens(line, commas, &tokens);
+  return tokens;
+}
+
+void SplitTokens(std::string_view line, bool commas, std::vector<std::string_view>* tokens) {
+  tokens->clear();
   std::size_t i = 0;
   const auto is_separator = [commas](char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f' || (commas && c == ',');
@@ -101,9 +107,8 @@ std::vector<std::string_view> SplitTokens(std::string_view line, bool commas) {
     while (i < line.size() && is_separator(line[i])) ++i;
     const std::size_t start = i;
     while (i < line.size() && !is_separator(line[i])) ++i;
-    if (i > start) tokens.push_back(line.substr(start, i - start));
+    if (i > start) tokens->push_back(line.substr(start, i - start));
   }
-  return tokens;
 }
 
 std::string_view Trim(std::string_view text) {

@@ -37,6 +37,8 @@ class LineReader {
 
 // Splits on spaces and tabs (and commas when `commas`); empty tokens are dropped.
 std::vector<std::string_view> SplitTokens(std::string_view line, bool commas = false);
+// Same into a reused vector (no allocation per line in data loops).
+void SplitTokens(std::string_view line, bool commas, std::vector<std::string_view>* tokens);
 std::string_view Trim(std::string_view text);
 // Parses a whole token as a number (decimal, optional sign and exponent;
 // "nan"/"inf" parse and are rejected later as non-finite). False if invalid.

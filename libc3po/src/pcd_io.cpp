@@ -242,11 +242,12 @@ PointSet ReadAsciiPcd(std::string_view bytes, const PcdHeader& header, const std
   points.Reserve(static_cast<std::size_t>(std::min<std::uint64_t>(
       header.points, (bytes.size() - header.data_offset) / (2 * values_per_point - 1) + 1)));
   std::string_view line;
+  std::vector<std::string_view> tokens;
   while (reader.Next(&line)) {
     if (Trim(line).empty()) continue;
     const std::uint64_t i = points.size();
     if (i == header.points) fail("unexpected data after the last point (header says " + std::to_string(header.points) + " points)");
-    const std::vector<std::string_view> tokens = SplitTokens(line);
+    SplitTokens(line, false, &tokens);
     if (tokens.size() != values_per_point) {
       fail("expected " + std::to_string(values_per_point) + " values, found " + std::to_string(tokens.size()));
     }

@@ -354,7 +354,8 @@ class PlyAsciiReader {
         throw InputError(name_, "truncated: header says " + std::to_string(element.count) + " " +
                                     element.Plural() + ", file holds " + std::to_string(i));
       }
-      ReadItem(e, i, SplitTokens(line));
+      SplitTokens(line, false, &tokens_);
+      ReadItem(e, i, tokens_);
     }
   }
 
@@ -401,6 +402,7 @@ class PlyAsciiReader {
   }
 
   LineReader reader_;
+  std::vector<std::string_view> tokens_;   // of the current line, reused
   std::size_t remaining_bytes_;
   const PlyHeader& header_;
   const std::string& name_;

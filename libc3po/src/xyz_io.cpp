@@ -15,10 +15,11 @@ PointSet ParseXyz(std::string_view bytes, const std::string& name) {
     throw InputError(name, "line " + std::to_string(reader.line_number()) + ": " + problem);
   };
   std::string_view line;
+  std::vector<std::string_view> tokens;
   while (reader.Next(&line)) {
     const std::size_t hash = line.find('#');
     if (hash != std::string_view::npos) line = line.substr(0, hash);
-    const std::vector<std::string_view> tokens = SplitTokens(line, true);
+    SplitTokens(line, true, &tokens);
     if (tokens.empty()) continue;
     if (tokens.size() < 3) fail("expected 3 coordinates, found " + std::to_string(tokens.size()));
     double xyz[3];
