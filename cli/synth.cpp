@@ -121,7 +121,7 @@ int Run(const SynthCommand& o) {
                        static_cast<std::size_t>(options.count));
   const SynthReport report =
       WriteSynthDataset(object.mesh(), object.spec(), options, o.output,
-                        [&](std::size_t done, std::size_t) { progress.Update(done); });
+                        [&](std::size_t done, std::size_t) { progress.Update(done); }, o.object);
   progress.Finish();
   std::printf("wrote %s: %zu %s clouds of %s (d = %.4g m), %.1f points on average (%d to %d), "
               "pose %s, seed %llu\n",

@@ -105,10 +105,11 @@ SynthReport Summarise(const std::vector<SampleStats>& stats, const SynthGenerato
 
 SynthReport WriteSynthDataset(const Mesh& mesh, const ObjectSpec& spec,
                               const SynthOptions& options, const std::string& dir,
-                              const SynthProgress& progress) {
+                              const SynthProgress& progress, const std::string& where) {
   const auto start = std::chrono::steady_clock::now();
-  const SynthGenerator generator(mesh, spec.keypoints, options,
-                                 spec.name.empty() ? std::string("object") : spec.name);
+  const SynthGenerator generator(
+      mesh, spec.keypoints, options,
+      !where.empty() ? where : spec.name.empty() ? std::string("object") : spec.name);
   DatasetWriter writer(dir);
   const int workers = std::max(1, DefaultThreadCount());
   auto renderers = MakeRenderers(generator, workers);

@@ -267,3 +267,49 @@ TEST_CASE("intrinsics parsing and checks") {
   CHECK_THROWS_AS(c3po::ParseIntrinsics("600,610,320.5,240.5,0,480"), c3po::InputError);
   CHECK_THROWS_AS(c3po::ParseIntrinsics("nan,610,320.5,240.5,640,480"), c3po::InputError);
 }
+
+TEST_CASE("back-face culling is exact on closed outward meshes") {
+  std::vector<c3po::Mesh> meshes{c3po::MakeBundledObject("mug").mesh,
+                                 c3po::MakeBundledObject("chair").mesh};
+  if (std::filesystem::exists(c3po::test::SharedData() + "/ycb/035_power_drill/textured.obj")) {
+    meshes.push_back(LoadYcbDrill());   // split at texture seams, with a zero-thickness fin
+  }
+  c3po::DepthRenderer culled(c3po::CameraIntrinsics{});
+  c3po::DepthRenderer full(c3po::CameraIntrinsics{});
+  c3po::Rng rng(21);
+  for (const c3po::Mesh& mesh : meshes) {
+    REQUIRE(c3po::IsClosedOutward(mesh));
+    const double d = mesh.Diameter();
+    for (int view = 0; view < 5; ++view) {
+      const c3po::Pose pose = PoseAtDistance(rng, mesh, 2.0 * d);
+      culled.Render(mesh, pose, true);
+      full.Render(mesh, pose, false);
+      REQUIRE(culled.covered_pixels() == full.covered_pixels());
+      for (int pixel : full.covered_pixels()) {
+        const int u = pixel % 640, v = pixel / 640;
+        CHECK(std::abs(culled.DepthAt(u, v) - full.DepthAt(u, v)) < 1e-12 * d);
+      }
+    }
+  }
+}
+
+TEST_CASE("IsClosedOutward rejects open, inverted and inconsistent meshes") {
+  const c3po::Mesh box = c3po::MakeCuboid({0, 0, 0}, {1, 2, 3}, 0.5);
+  CHECK(c3po::IsClosedOutward(box));
+  c3po::Mesh open = box;
+  open.triangles = box.triangles.leftCols(box.triangles.cols() - 1);
+  CHECK_FALSE(c3po::IsClosedOutward(open));
+  c3po::Mesh inverted = box;
+  c3po::FlipTriangles(&inverted);
+  CHECK_FALSE(c3po::IsClosedOutward(inverted));
+  c3po::Mesh one_flipped = box;
+  std::swap(one_flipped.triangles(1, 3), one_flipped.triangles(2, 3));
+  CHECK_FALSE(c3po::IsClosedOutward(one_flipped));
+  // Splitting vertices (as loaders do at texture seams) keeps it closed.
+  c3po::Mesh split = box;
+  split.vertices.conservativeResize(3, box.vertices.cols() + 1);
+  split.vertices.col(box.vertices.cols()) = box.vertices.col(split.triangles(0, 0));
+  split.triangles(0, 0) = static_cast<int>(box.vertices.cols());
+  CHECK(c3po::IsClosedOutward(split));
+  CHECK_FALSE(c3po::IsClosedOutward(c3po::Mesh{}));
+}

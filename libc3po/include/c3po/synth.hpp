@@ -150,10 +150,11 @@ using SynthProgress = std::function<void(std::size_t done, std::size_t total)>;
 // Generates options.count samples on all cores and writes them with
 // DatasetWriter to `dir` (000000.ply ..., manifest.jsonl), committing only when
 // complete. `progress` is called from the calling thread between batches.
-// Throws InputError (nothing left behind) or Interrupted.
+// `where` names the object in messages (default: spec.name). Throws
+// InputError (nothing left behind) or Interrupted.
 SynthReport WriteSynthDataset(const Mesh& mesh, const ObjectSpec& spec,
                               const SynthOptions& options, const std::string& dir,
-                              const SynthProgress& progress = {});
+                              const SynthProgress& progress = {}, const std::string& where = "");
 
 // Speed of cloud generation (no file output): repeats batches of
 // options.count clouds on all cores until `min_seconds` have passed.
