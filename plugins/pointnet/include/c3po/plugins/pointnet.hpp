@@ -167,7 +167,12 @@ class PointNetDetector : public Detector {
   std::string training_info_json() const;
   void set_training_info_json(const std::string& json);   // throws std::invalid_argument if not an object
 
-  // Flat weights (float32) and their layout, for tests and tools.
+  // Flat weights (float32) and their layout, for tests and tools. Blocks in
+  // order: "point_mlp.<l>.weight", "point_mlp.<l>.bias" per MLP stage, then
+  // "head.<h>.weight", "head.<h>.bias" per hidden head layer, then
+  // "output.weight", "output.bias". Every weight is C_out x C_in,
+  // column-major (entry (o, i) at o + i * C_out; also tiny-dnn's fully
+  // connected layout). Outputs are keypoint after keypoint (x, y, z).
   struct WeightBlock {
     std::string name;
     std::size_t offset = 0;
