@@ -5,10 +5,12 @@
 #include "c3po/dataset.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -33,11 +35,20 @@ std::string StripTrailingSlashes(std::string path) {
   return path;
 }
 
+// `text` with control characters replaced, so messages stay on one line.
+std::string Printable(const std::string& text) {
+  std::string printable = text.substr(0, 200);
+  for (char& c : printable) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return printable;
+}
+
 // Why `cloud` is not a safe path inside the dataset folder, or nullopt.
 std::optional<std::string> CloudPathProblem(const std::string& cloud) {
   if (cloud.empty()) return "empty path";
   if (cloud.find('\0') != std::string::npos) return "path contains a NUL character";
-  if (cloud.front() == '/') return "absolute path '" + cloud + "' (must be relative to the dataset folder)";
+  if (cloud.front() == '/') return "absolute path '" + Printable(cloud) + "' (must be relative to the dataset folder)";
   int depth = 0;
   std::size_t start = 0;
   while (start <= cloud.size()) {
@@ -45,13 +56,13 @@ std::optional<std::string> CloudPathProblem(const std::string& cloud) {
     if (end == std::string::npos) end = cloud.size();
     const std::string part = cloud.substr(start, end - start);
     if (part == "..") {
-      if (--depth < 0) return "path '" + cloud + "' escapes the dataset folder";
+      if (--depth < 0) return "path '" + Printable(cloud) + "' escapes the dataset folder";
     } else if (!part.empty() && part != ".") {
       ++depth;
     }
     start = end + 1;
   }
-  if (depth == 0 || cloud.back() == '/') return "path '" + cloud + "' does not name a file";
+  if (depth == 0 || cloud.back() == '/') return "path '" + Printable(cloud) + "' does not name a file";
   return std::nullopt;
 }
 
@@ -218,6 +229,24 @@ void SyncFileSystemOf(const std::string& folder) {
   ::close(fd);
 }
 
+// Removes ".<name>.partial.<pid>" siblings left by writers that were killed
+// (their process no longer exists); live writers' folders are kept.
+void RemoveStalePartials(const std::string& parent, const std::string& name) {
+  const std::string prefix = "." + name + ".partial.";
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string leaf = it->path().filename().string();
+    if (leaf.rfind(prefix, 0) != 0) continue;
+    const std::string pid_text = leaf.substr(prefix.size());
+    if (pid_text.empty() || pid_text.find_first_not_of("0123456789") != std::string::npos || pid_text.size() > 9) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(pid_text));
+    if (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH) {
+      std::error_code ignored;
+      fs::remove_all(it->path(), ignored);
+    }
+  }
+}
+
 [[noreturn]] void FailWrite(const std::string& path, const std::error_code& ec) {
   throw InputError(path, "cannot write: " + ec.message());
 }
@@ -317,7 +346,7 @@ Dataset ReadDataset(const std::string& dir_argument) {
       keypoints_line = line_number;
     }
     if (!fs::is_regular_file(dir + "/" + entry.cloud, ec)) {
-      throw InputError(where + ": cloud: no such file '" + dir + "/" + entry.cloud + "'");
+      throw InputError(where + ": cloud: no such file '" + dir + "/" + Printable(entry.cloud) + "'");
     }
     dataset.entries.push_back(std::move(entry));
   }
@@ -335,6 +364,7 @@ DatasetWriter::DatasetWriter(std::string dir) : dir_(StripTrailingSlashes(std::m
   std::error_code ec;
   fs::create_directories(parent, ec);
   if (ec) FailWrite(dir_, ec);
+  RemoveStalePartials(parent, name);
   tmp_dir_ = parent + "/." + name + ".partial." + std::to_string(::getpid());
   fs::remove_all(tmp_dir_, ec);
   if (!fs::create_directory(tmp_dir_, ec) || ec) FailWrite(dir_, ec ? ec : std::make_error_code(std::errc::file_exists));

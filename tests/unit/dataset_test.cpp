@@ -1,6 +1,8 @@
 // Dataset folders: exact manifest round trips, field validation with line
 // numbers, and DatasetWriter's all-or-nothing behaviour.
 #include <doctest/doctest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -135,6 +137,7 @@ TEST_CASE("malformed manifest lines name the line and the field") {
   CHECK(ParseError("{\"cloud\":\"a.ply\",\"visible\":[1]}") == "m.jsonl: line 4: visible: expected booleans, found number");
   CHECK(ParseError("{\"cloud\":\"a.ply\"").rfind("m.jsonl: line 4: not valid JSON: ", 0) == 0);
   CHECK(ParseError("[1,2,3]") == "m.jsonl: line 4: expected a JSON object");
+  CHECK(ParseError("{\"cloud\":\"../a\\nb.ply\"}") == "m.jsonl: line 4: cloud: path '../a?b.ply' escapes the dataset folder");
   CHECK(ParseError(std::string(100000, '[')) == "m.jsonl: line 4: JSON nested too deeply");
 }
 
@@ -216,6 +219,32 @@ TEST_CASE("DatasetWriter: abandoned writer leaves nothing; commit replaces an ol
     writer.Add(0, entry, RandomPoints(rng, 5));
   }   // no Commit: as if interrupted
   CHECK(fs::is_empty(dir.path()));
+
+  // A writer killed outright (no destructor) leaves its partial folder; the
+  // next writer removes it when that process is gone, and keeps live ones.
+  int pipe_fds[2];
+  REQUIRE(::pipe(pipe_fds) == 0);
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {   // idle until the pipe closes, then exit without cleanup
+    ::close(pipe_fds[1]);
+    char byte;
+    while (::read(pipe_fds[0], &byte, 1) > 0) {}
+    ::_exit(0);
+  }
+  ::close(pipe_fds[0]);
+  const std::string dead = dir / ".ds.partial.999999999";   // beyond pid_max: no such process
+  const std::string alive = dir / ".ds.partial." + std::to_string(child);
+  fs::create_directory(dead);
+  fs::create_directory(alive);
+  {
+    c3po::DatasetWriter writer(target);
+  }
+  CHECK_FALSE(fs::exists(dead));
+  CHECK(fs::exists(alive));
+  ::close(pipe_fds[1]);
+  ::waitpid(child, nullptr, 0);
+  fs::remove_all(alive);
 
   {
     c3po::DatasetWriter writer(target);
