@@ -1,8 +1,262 @@
-// c3po eval
+// c3po eval: the paper's table rows (KeyPo, + ICP, + corrector, C-3PO on the
+// certified subsets) on a dataset with ground truth; terminal table, JSON and
+// a self-contained HTML report.
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "c3po/atomic_file.hpp"
+#include "c3po/dataset.hpp"
+#include "c3po/error.hpp"
+#include "c3po/evaluation.hpp"
+#include "c3po/object_io.hpp"
+#include "c3po/plugins/registry.hpp"
+#include "c3po/report.hpp"
 #include "command.hpp"
+#include "common.hpp"
 
 namespace c3po::cli {
+namespace {
 
-RunFunction SetupEval(CLI::App& command) { return NotBuiltYet(command, "Evaluation, baselines, reports and the end-to-end demo"); }
+namespace fs = std::filesystem;
+
+struct EvalCommand {
+  std::string object_path;
+  std::string data_dir;
+  std::vector<std::string> models;
+  std::vector<std::string> selftrained;
+  std::vector<std::string> detectors;
+  std::vector<std::string> plugins;
+  std::string adds_threshold = "5%d";
+  std::string auc_max = "10%d";
+  std::string adds_variant = "symmetric";
+  std::string eps_oc_text;
+  std::string delta_nd_text;
+  std::string solver = "fast";
+  std::string loss = "mean";
+  bool no_icp = false;
+  int icp_iterations = 30;
+  std::string icp_max_distance;
+  double icp_trim = 0.0;
+  std::string json_path;
+  std::string report_path;
+  std::vector<std::string> training_logs;
+  int views = 3;
+  int worst = 5;
+};
+
+// A detector to evaluate, owning what it loaded.
+struct LoadedDetector {
+  std::string label;
+  std::unique_ptr<Detector> detector;   // null: the manifest's detected_keypoints
+  bool self_trained = false;
+  std::string model_path;               // empty for named detectors
+};
+
+// The JSON header line of a model file (empty object when it has none).
+nlohmann::json ModelHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open model file");
+  std::string line;
+  std::getline(in, line);
+  nlohmann::json header = nlohmann::json::parse(line, nullptr, false);
+  return header.is_object() ? header : nlohmann::json::object();
+}
+
+bool FlaggedSelfTrained(const nlohmann::json& header) {
+  for (const char* key : {"selftrained", "self_trained"}) {
+    if (header.contains(key) && header[key].is_boolean() && header[key].get<bool>()) return true;
+  }
+  return false;
+}
+
+std::string UniqueLabel(std::string label, const std::vector<LoadedDetector>& existing) {
+  const std::string base = label;
+  for (int k = 2;; ++k) {
+    const bool taken = std::any_of(existing.begin(), existing.end(),
+                                   [&](const LoadedDetector& d) { return d.label == label; });
+    if (!taken) return label;
+    label = base + " #" + std::to_string(k);
+  }
+}
+
+std::vector<LoadedDetector> LoadDetectors(const EvalCommand& cmd, const ObjectModel& object) {
+  for (const auto& plugin : cmd.plugins) LoadPlugin(plugin);
+  std::vector<LoadedDetector> detectors;
+  auto add_model = [&](const std::string& path, bool self_trained) {
+    LoadedDetector d;
+    d.detector = LoadDetectorModel(path, object);
+    d.self_trained = self_trained || FlaggedSelfTrained(ModelHeader(path));
+    d.label = UniqueLabel(fs::path(path).stem().string(), detectors);
+    d.model_path = path;
+    detectors.push_back(std::move(d));
+  };
+  for (const auto& path : cmd.models) add_model(path, false);
+  for (const auto& path : cmd.selftrained) add_model(path, true);
+  for (const auto& name : cmd.detectors) {
+    LoadedDetector d;
+    if (name != "manifest") d.detector = CreateDetector(name, object);
+    d.label = UniqueLabel(name, detectors);
+    detectors.push_back(std::move(d));
+  }
+  if (detectors.empty()) {
+    throw InputError("c3po eval", "give at least one --model FILE, --selftrained FILE or --detector NAME");
+  }
+  return detectors;
+}
+
+EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object) {
+  const double d = object.diameter();
+  EvaluationOptions options = EvaluationOptions::Defaults(object);
+  options.adds_threshold = ParseThreshold(cmd.adds_threshold, d, "--adds-threshold");
+  options.auc_max = ParseThreshold(cmd.auc_max, d, "--auc-max");
+  options.adds_variant = ParseAddSVariant(cmd.adds_variant);
+  if (!cmd.eps_oc_text.empty()) options.pipeline.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, d, "--eps-oc");
+  if (!cmd.delta_nd_text.empty()) {
+    options.pipeline.certificate.delta_nd = ParseThreshold(cmd.delta_nd_text, d, "--delta-nd");
+  }
+  if (!(options.pipeline.certificate.eps_oc > 0) || !(options.pipeline.certificate.delta_nd > 0)) {
+    throw InputError(cmd.object_path, "the object has no eps_oc / delta_nd: give --eps-oc and --delta-nd");
+  }
+  options.pipeline.corrector.solver = ParseCorrectorSolver(cmd.solver);
+  options.pipeline.corrector.loss = ParsePointCloudLoss(cmd.loss);
+  options.run_icp = !cmd.no_icp;
+  options.icp.max_iterations = cmd.icp_iterations;
+  options.icp.trim_fraction = cmd.icp_trim;
+  if (!cmd.icp_max_distance.empty()) {
+    options.icp.max_correspondence_distance = ParseThreshold(cmd.icp_max_distance, d, "--icp-max-distance");
+  }
+  options.worst_listed = cmd.worst;
+  try {
+    options.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("c3po eval", e.what());
+  }
+  return options;
+}
+
+std::string LogLabel(const std::string& path) {
+  std::string name = fs::path(path).filename().string();
+  for (const char* suffix : {".log.jsonl", ".jsonl"}) {
+    const std::string s = suffix;
+    if (name.size() > s.size() && name.compare(name.size() - s.size(), s.size(), s) == 0) {
+      return name.substr(0, name.size() - s.size());
+    }
+  }
+  return name;
+}
+
+// --training-log files, then MODEL.log.jsonl next to every model given.
+std::vector<TrainingLog> ReadTrainingLogs(const EvalCommand& cmd, const std::vector<LoadedDetector>& detectors) {
+  std::vector<TrainingLog> logs;
+  std::vector<std::string> seen;
+  auto read = [&](const std::string& path, const std::string& label) {
+    const std::string canonical = fs::weakly_canonical(path).string();
+    if (std::find(seen.begin(), seen.end(), canonical) != seen.end()) return;
+    seen.push_back(canonical);
+    logs.push_back(ReadTrainingLog(path, label));
+  };
+  for (const auto& path : cmd.training_logs) read(path, LogLabel(path));
+  for (const auto& d : detectors) {
+    if (d.model_path.empty()) continue;
+    for (const std::string& candidate :
+         {d.model_path + ".log.jsonl", (fs::path(d.model_path).replace_extension(".log.jsonl")).string()}) {
+      if (fs::is_regular_file(candidate)) {
+        read(candidate, d.label);
+        break;
+      }
+    }
+  }
+  return logs;
+}
+
+std::string CommandLine(const EvalCommand& cmd) {
+  std::string line = "c3po eval " + cmd.object_path + " --data " + cmd.data_dir;
+  for (const auto& m : cmd.models) line += " --model " + m;
+  for (const auto& m : cmd.selftrained) line += " --selftrained " + m;
+  for (const auto& d : cmd.detectors) line += " --detector " + d;
+  line += " --adds " + cmd.adds_variant + " --adds-threshold " + cmd.adds_threshold + " --auc-max " + cmd.auc_max;
+  if (!cmd.eps_oc_text.empty()) line += " --eps-oc " + cmd.eps_oc_text;
+  if (!cmd.delta_nd_text.empty()) line += " --delta-nd " + cmd.delta_nd_text;
+  if (cmd.no_icp) line += " --no-icp";
+  return line;
+}
+
+int Run(const EvalCommand& cmd) {
+  const ObjectModel object = LoadObject(cmd.object_path);
+  const EvaluationOptions options = MakeOptions(cmd, object);
+  if (cmd.views < 0) throw InputError("c3po eval", "--views must be >= 0");
+  const Dataset dataset = ReadDataset(cmd.data_dir);
+  const std::vector<LoadedDetector> loaded = LoadDetectors(cmd, object);
+  std::vector<EvaluatedDetector> detectors;
+  for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});
+  std::vector<TrainingLog> logs;
+  if (!cmd.report_path.empty()) logs = ReadTrainingLogs(cmd, loaded);   // fail before the long work
+
+  ProgressBar progress("eval", dataset.entries.size());
+  const Evaluation evaluation =
+      Evaluate(object, dataset, detectors, options, [&](std::size_t done, std::size_t) { progress.Update(done); });
+  progress.Finish();
+
+  const bool json_to_stdout = cmd.json_path == "-";
+  (json_to_stdout ? std::cerr : std::cout) << EvaluationTable(evaluation);
+  if (json_to_stdout) {
+    std::cout << EvaluationJson(evaluation);
+  } else if (!cmd.json_path.empty()) {
+    WriteFileAtomically(cmd.json_path, EvaluationJson(evaluation));
+    std::cerr << "wrote " << cmd.json_path << "\n";
+  }
+  if (!cmd.report_path.empty()) {
+    ReportInput report;
+    report.evaluation = &evaluation;
+    report.training = std::move(logs);
+    report.command_line = CommandLine(cmd);
+    ReportViewOptions view_options;
+    view_options.certified = cmd.views;
+    view_options.rejected = cmd.views;
+    if (const EvaluationRow* row = evaluation.MainRow()) {
+      report.views = SelectReportViews(object, dataset, *row, options.adds_threshold, view_options);
+    }
+    WriteReport(cmd.report_path, report);
+    std::cerr << "wrote " << cmd.report_path << " (" << report.views.size() << " 3D examples, "
+              << report.training.size() << " training logs)\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+RunFunction SetupEval(CLI::App& command) {
+  auto cmd = std::make_shared<EvalCommand>();
+  command.add_option("object", cmd->object_path, "Object JSON")->required();
+  command.add_option("--data", cmd->data_dir, "Dataset folder with ground truth (manifest.jsonl + clouds)")->required();
+  command.add_option("--model", cmd->models, "Trained detector model file (row label = file stem); repeatable")->allow_extra_args(false);
+  command.add_option("--selftrained", cmd->selftrained,
+                     "Self-trained model file: C-3PO rows (also when a model header says \"selftrained\": true); repeatable")->allow_extra_args(false);
+  command.add_option("--detector", cmd->detectors,
+                     "Detector without a model file (svd; manifest = the manifest's detected_keypoints)->allow_extra_args(false); repeatable");
+  command.add_option("--plugin", cmd->plugins, "Load a detector plugin (shared library)->allow_extra_args(false); repeatable");
+  command.add_option("--adds", cmd->adds_variant, "ADD-S variant: symmetric (default; the paper's final tables) or one-sided");
+  command.add_option("--adds-threshold", cmd->adds_threshold, "ADD-S score threshold: distance or fraction of d (default 5%d)");
+  command.add_option("--auc-max", cmd->auc_max, "Upper end of the ADD-S AUC curve (default 10%d)");
+  command.add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold (default: the object's)");
+  command.add_option("--delta-nd", cmd->delta_nd_text, "Non-degeneracy threshold (default: the object's)");
+  command.add_option("--solver", cmd->solver, "Corrector solver: fast (default) or gd");
+  command.add_option("--loss", cmd->loss, "Point-cloud loss: mean (default) or max");
+  command.add_flag("--no-icp", cmd->no_icp, "Skip the KeyPo + ICP rows");
+  command.add_option("--icp-iterations", cmd->icp_iterations, "ICP iterations (default 30)");
+  command.add_option("--icp-max-distance", cmd->icp_max_distance, "ICP correspondence gate (default: none)");
+  command.add_option("--icp-trim", cmd->icp_trim, "ICP: fraction of the farthest pairs dropped (default 0)");
+  command.add_option("--json", cmd->json_path, "Write everything as JSON to FILE (atomically); '-' = stdout (table on stderr)");
+  command.add_option("--report", cmd->report_path, "Write a self-contained HTML report");
+  command.add_option("--training-log", cmd->training_logs,
+                     "Training log (JSON lines) for the report; MODEL.log.jsonl next to each model is found automatically")->allow_extra_args(false);
+  command.add_option("--views", cmd->views, "3D examples in the report: this many certified and rejected (default 3)");
+  command.add_option("--worst", cmd->worst, "False certificates listed per row (default 5)");
+  return [cmd]() { return Run(*cmd); };
+}
 
 }  // namespace c3po::cli

@@ -1,0 +1,299 @@
+// Evaluation against brute-force oracles on a tiny dataset with known poses
+// (evaluation_fixture.hpp): poses, ADD-S, certificates, scores, AUC, medians,
+// subsets and false certificates are recomputed here independently.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "c3po/error.hpp"
+#include "c3po/evaluation.hpp"
+#include "evaluation_fixture.hpp"
+#include "test_helpers.hpp"
+
+using namespace c3po;
+using namespace c3po::test;
+
+namespace {
+
+constexpr int kClouds = 12;
+
+// mean_i min_j ||a_i - b_j||, by brute force.
+double MeanNearest(const PointSet& a, const PointSet& b) {
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < a.cols(); ++i) sum += (b.colwise() - a.col(i)).colwise().norm().minCoeff();
+  return sum / static_cast<double>(a.cols());
+}
+
+double BruteAddS(const ObjectModel& object, const Pose& truth, const Pose& estimate, AddSVariant variant) {
+  const PointSet a = truth * object.sample(), b = estimate * object.sample();
+  return MeanNearest(a, b) + (variant == AddSVariant::kSymmetric ? MeanNearest(b, a) : 0.0);
+}
+
+double DistanceToSet(const Eigen::Vector3d& q, const PointSet& points) {
+  return (points.colwise() - q).colwise().norm().minCoeff();
+}
+
+// oc and nd of an estimate by brute force (method.md "Certificates").
+std::pair<bool, bool> BruteCertificate(const ObjectModel& object, const PointSet& cloud, const Pose& estimate,
+                                       const PointSet& keypoints, double eps_oc, double delta_nd) {
+  const PointSet posed = estimate * object.sample();
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < cloud.cols(); ++i) worst = std::max(worst, DistanceToSet(cloud.col(i), posed));
+  const PointSet posed_keypoints = estimate * object.keypoints();
+  const double agreement = (keypoints - posed_keypoints).colwise().norm().maxCoeff();
+  const bool oc = worst < eps_oc && agreement < eps_oc;
+  bool nd = object.spec().indicator_sets.empty();
+  for (const auto& set : object.spec().indicator_sets) {
+    bool all_near = true;
+    for (int k : set) all_near = all_near && DistanceToSet(posed_keypoints.col(k), cloud) < delta_nd;
+    nd = nd || all_near;
+  }
+  return {oc, nd};
+}
+
+double BruteRotationError(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return std::acos(std::clamp(((a.transpose() * b).trace() - 1.0) / 2.0, -1.0, 1.0));
+}
+
+// (100 / m) * integral_0^m fraction{e < t} dt by the midpoint rule.
+double NumericAuc(const std::vector<double>& errors, double m) {
+  const int steps = 20000;
+  double sum = 0.0;
+  for (int s = 0; s < steps; ++s) {
+    const double t = (s + 0.5) * m / steps;
+    sum += std::count_if(errors.begin(), errors.end(), [t](double e) { return e < t; });
+  }
+  return 100.0 * sum / (steps * static_cast<double>(errors.size()));
+}
+
+double SortedMedian(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct Fixture {
+  ObjectModel object = EvaluationObject();
+  TempDir dir{"evaluation_test"};
+  Dataset dataset;
+  std::vector<Pose> poses = EvaluationPoses(kClouds);
+  Fixture() {
+    WriteEvaluationDataset(object, dir / "data", kClouds);
+    dataset = ReadDataset(dir / "data");
+  }
+};
+
+// Every sample of `row` against the oracles; returns the brute-force ADD-S values.
+std::vector<double> CheckSamples(const Fixture& f, const EvaluationRow& row, const EvaluationOptions& options) {
+  std::vector<double> adds;
+  for (const SampleResult& s : row.samples) {
+    CAPTURE(row.label);
+    CAPTURE(s.cloud);
+    if (!s.ok()) {
+      CHECK(std::isinf(s.adds));
+      CHECK_FALSE(s.certified());
+      adds.push_back(std::numeric_limits<double>::infinity());
+      continue;
+    }
+    const Pose& truth = f.poses[s.index];
+    const double expected = BruteAddS(f.object, truth, s.scene_from_model, options.adds_variant);
+    CHECK(s.adds == doctest::Approx(expected).epsilon(1e-9));
+    CHECK(s.rotation_error == doctest::Approx(BruteRotationError(s.scene_from_model.R, truth.R)).epsilon(1e-6));
+    CHECK(s.translation_error == doctest::Approx((s.scene_from_model.t - truth.t).norm()).epsilon(1e-9));
+    const auto [oc, nd] = BruteCertificate(f.object, f.dataset.LoadCloud(s.index), s.scene_from_model, s.keypoints,
+                                           options.pipeline.certificate.eps_oc, options.pipeline.certificate.delta_nd);
+    CHECK(s.oc == oc);
+    CHECK(s.nd == nd);
+    adds.push_back(expected);
+  }
+  return adds;
+}
+
+void CheckSummary(const EvaluationRow& row, const std::vector<double>& adds, const EvaluationOptions& options,
+                  double diameter) {
+  CAPTURE(row.label);
+  const RowSummary& s = row.summary;
+  const double n = static_cast<double>(adds.size());
+  REQUIRE(s.n == static_cast<int>(adds.size()));
+  const auto below = std::count_if(adds.begin(), adds.end(), [&](double a) { return a < options.adds_threshold; });
+  CHECK(s.adds_score == doctest::Approx(100.0 * below / n));
+  CHECK(s.adds_auc == doctest::Approx(NumericAuc(adds, options.auc_max)).epsilon(1e-3));
+  std::vector<double> rotation, translation;
+  int oc = 0, nd = 0, certified = 0, false_certificates = 0;
+  for (std::size_t k = 0; k < row.samples.size(); ++k) {
+    const SampleResult& sample = row.samples[k];
+    // (each rotation error was checked against the brute force in CheckSamples)
+    rotation.push_back(sample.ok() ? sample.rotation_error : M_PI);
+    translation.push_back(sample.translation_error);
+    oc += sample.oc;
+    nd += sample.nd;
+    certified += sample.oc && sample.nd;
+    false_certificates += sample.oc && sample.nd && !(adds[k] < options.adds_threshold);
+  }
+  CHECK(s.median_rotation_error == doctest::Approx(SortedMedian(rotation)));
+  CHECK(s.median_translation_error_over_d == doctest::Approx(SortedMedian(translation) / diameter));
+  CHECK(s.percent_oc == doctest::Approx(100.0 * oc / n));
+  CHECK(s.percent_nd == doctest::Approx(100.0 * nd / n));
+  CHECK(s.percent_certified == doctest::Approx(100.0 * certified / n));
+  CHECK(s.false_certificates == false_certificates);
+}
+
+}  // namespace
+
+TEST_CASE("KeyPo, ICP and corrector rows match brute-force ADD-S, certificates and scores") {
+  Fixture f;
+  EvaluationOptions options = EvaluationOptions::Defaults(f.object);
+  REQUIRE(options.adds_variant == AddSVariant::kSymmetric);
+  const Evaluation e = Evaluate(f.object, f.dataset, {{"manifest", nullptr, false}}, options);
+  REQUIRE(e.rows.size() == 3);
+  CHECK(e.rows[0].label == "KeyPo (manifest)");
+  CHECK(e.rows[1].label == "KeyPo (manifest) + ICP");
+  CHECK(e.rows[2].label == "KeyPo (manifest) + corrector");
+  CHECK(e.clouds == kClouds);
+
+  // The registration of exact keypoints is the pose that posed them.
+  const EvaluationRow& keypo = e.rows[0];
+  REQUIRE(keypo.samples.size() == kClouds);
+  for (int i = 0; i < kClouds; ++i) {
+    const SampleResult& s = keypo.samples[i];
+    CAPTURE(i);
+    CHECK(s.index == static_cast<std::size_t>(i));
+    if (KindOf(i) == DetectedKind::kDegenerate) {
+      CHECK_FALSE(s.ok());
+      continue;
+    }
+    REQUIRE(s.ok());
+    const Pose expected = KindOf(i) == DetectedKind::kTruth ? f.poses[i] : f.poses[i] * WrongTurn();
+    CHECK((s.scene_from_model.R - expected.R).norm() < 1e-9);
+    CHECK((s.scene_from_model.t - expected.t).norm() < 1e-9);
+    // Exact keypoints on a cloud from the model sample: oc = 1; nd = 0 only on partial clouds.
+    if (KindOf(i) == DetectedKind::kTruth) {
+      CHECK(s.oc);
+      CHECK(s.nd == !IsPartial(i));
+    }
+  }
+  for (const auto& row : e.rows) CheckSummary(row, CheckSamples(f, row, options), options, f.object.diameter());
+  // By construction: 6 exact detections (ADD-S 0), 3 wrong by 90 degrees, 3 failures.
+  CHECK(keypo.summary.adds_score == doctest::Approx(50.0));
+  CHECK(keypo.summary.failures == 3);
+  CHECK(keypo.summary.percent_certified == doctest::Approx(100.0 * 4 / kClouds));
+  CHECK(e.total_false_certificates() == 0);
+}
+
+TEST_CASE("self-trained detectors give the C-3PO rows on the certified subsets") {
+  Fixture f;
+  EvaluationOptions options = EvaluationOptions::Defaults(f.object);
+  options.adds_variant = AddSVariant::kOneSided;
+  options.run_icp = false;
+  const Evaluation e = Evaluate(f.object, f.dataset, {{"sim", nullptr, false}, {"self", nullptr, true}}, options);
+  REQUIRE(e.rows.size() == 5);
+  CHECK(e.rows[0].label == "KeyPo (sim)");
+  CHECK(e.rows[1].label == "KeyPo (sim) + corrector");
+  CHECK(e.rows[2].label == "C-3PO (self)");
+  CHECK(e.rows[3].label == "C-3PO (self) (oc = 1)");
+  CHECK(e.rows[4].label == "C-3PO (self) (oc = nd = 1)");
+  CHECK(e.MainRow() == &e.rows[2]);
+  // Same detections: the C-3PO row equals the corrector row sample by sample.
+  const EvaluationRow& all = e.rows[2];
+  REQUIRE(all.samples.size() == e.rows[1].samples.size());
+  std::vector<std::size_t> oc_indices, certified_indices;
+  for (std::size_t k = 0; k < all.samples.size(); ++k) {
+    CHECK(all.samples[k].adds == e.rows[1].samples[k].adds);
+    if (all.samples[k].oc) oc_indices.push_back(all.samples[k].index);
+    if (all.samples[k].certified()) certified_indices.push_back(all.samples[k].index);
+  }
+  std::vector<std::size_t> got_oc, got_certified;
+  for (const auto& s : e.rows[3].samples) got_oc.push_back(s.index);
+  for (const auto& s : e.rows[4].samples) got_certified.push_back(s.index);
+  CHECK(got_oc == oc_indices);
+  CHECK(got_certified == certified_indices);
+  CHECK(!certified_indices.empty());
+  for (const auto& row : e.rows) CheckSummary(row, CheckSamples(f, row, options), options, f.object.diameter());
+  CHECK(e.rows[4].summary.percent_certified == doctest::Approx(100.0));
+}
+
+TEST_CASE("loose certificate thresholds produce false certificates that are counted and listed worst first") {
+  Fixture f;
+  EvaluationOptions options = EvaluationOptions::Defaults(f.object);
+  options.run_icp = false;
+  options.pipeline.certificate.eps_oc = 2.0 * f.object.diameter();
+  options.pipeline.certificate.delta_nd = 2.0 * f.object.diameter();
+  options.worst_listed = 2;
+  const Evaluation e = Evaluate(f.object, f.dataset, {{"m", nullptr, false}}, options);
+  const EvaluationRow& keypo = e.rows[0];
+  const std::vector<double> adds = CheckSamples(f, keypo, options);
+  CheckSummary(keypo, adds, options, f.object.diameter());
+  // The three 90-degree errors are now certified: three false certificates.
+  std::vector<double> wrong;
+  for (int i = 0; i < kClouds; ++i) {
+    if (KindOf(i) == DetectedKind::kWrongPose) wrong.push_back(adds[i]);
+  }
+  std::sort(wrong.rbegin(), wrong.rend());
+  CHECK(keypo.summary.false_certificates == 3);
+  REQUIRE(keypo.summary.worst_false_certificates.size() == 2);
+  CHECK(keypo.summary.worst_false_certificates[0].adds == doctest::Approx(wrong[0]));
+  CHECK(keypo.summary.worst_false_certificates[1].adds == doctest::Approx(wrong[1]));
+  CHECK(e.total_false_certificates() >= 3);
+  const std::string table = EvaluationTable(e);
+  CHECK(table.find("Soundness: " + std::to_string(e.total_false_certificates()) + " false certificates") !=
+        std::string::npos);
+  CHECK(table.find("ADD-S variant: symmetric") != std::string::npos);
+}
+
+TEST_CASE("Summarize: empty subsets, failures and the false-certificate order") {
+  EvaluationOptions options;
+  options.adds_threshold = 1.0;
+  options.auc_max = 2.0;
+  const RowSummary empty = Summarize({}, options, 1.0);
+  CHECK(empty.n == 0);
+  CHECK(std::isnan(empty.adds_score));
+  CHECK(std::isnan(empty.percent_certified));
+
+  std::vector<SampleResult> samples(4);
+  const double adds[] = {0.5, 3.0, 1.0, std::numeric_limits<double>::infinity()};
+  for (int k = 0; k < 4; ++k) {
+    samples[k].index = k;
+    samples[k].cloud = "c" + std::to_string(k);
+    samples[k].adds = adds[k];
+    samples[k].oc = samples[k].nd = k < 3;
+  }
+  samples[3].error = "registration failed";
+  const RowSummary s = Summarize(samples, options, 1.0);
+  CHECK(s.failures == 1);
+  CHECK(s.adds_score == doctest::Approx(25.0));               // only 0.5 < 1 (strict)
+  CHECK(s.adds_auc == doctest::Approx(NumericAuc({0.5, 3.0, 1.0, INFINITY}, 2.0)).epsilon(1e-3));
+  CHECK(s.false_certificates == 2);                          // 3.0 and 1.0 (not below 1.0)
+  REQUIRE(s.worst_false_certificates.size() == 2);
+  CHECK(s.worst_false_certificates[0].cloud == "c1");
+  CHECK(s.worst_false_certificates[1].cloud == "c2");
+}
+
+TEST_CASE("a dataset without ground truth or without detected keypoints is an input error") {
+  const ObjectModel object = EvaluationObject();
+  TempDir dir("evaluation_test_bad");
+  {
+    DatasetWriter writer(dir / "nogt");
+    DatasetEntry entry;
+    entry.cloud = "a.ply";
+    entry.detected_keypoints = object.keypoints();
+    writer.Add(0, entry, object.sample());
+    writer.Commit();
+  }
+  {
+    DatasetWriter writer(dir / "nodet");
+    DatasetEntry entry;
+    entry.cloud = "a.ply";
+    entry.pose = Pose::Identity();
+    entry.keypoints = object.keypoints();
+    writer.Add(0, entry, object.sample());
+    writer.Commit();
+  }
+  const EvaluationOptions options = EvaluationOptions::Defaults(object);
+  CHECK_THROWS_AS(Evaluate(object, ReadDataset(dir / "nogt"), {{"m", nullptr, false}}, options), InputError);
+  CHECK_THROWS_AS(Evaluate(object, ReadDataset(dir / "nodet"), {{"m", nullptr, false}}, options), InputError);
+  EvaluationOptions bad = options;
+  bad.adds_threshold = 0.0;
+  CHECK_THROWS_AS(Evaluate(object, ReadDataset(dir / "nodet"), {{"m", nullptr, false}}, bad), std::invalid_argument);
+}
