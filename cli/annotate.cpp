@@ -179,11 +179,31 @@ int Run(const AnnotateCommand& o) {
   return 0;
 }
 
+const char* const kNotes = R"(
+Notes:
+  Coordinates (--keypoint, --from-json, --from-keypointnet) are in object units
+  (metres); the mesh is converted from --units first. Each point is snapped to
+  the nearest surface point and the distance printed; a point farther than
+  --max-snap is an error unless --no-snap.
+  Sources combine, in this order: --edit's keypoints (minus --remove), --keypoint,
+  --from-json, --from-keypointnet, then --auto (spread away from all of those).
+  --remove I refers to the edited object's indices; indicator sets are renumbered.
+  A set that contains a removed keypoint makes the command refuse, unless
+  --drop-sets, which drops such sets (printed). The annotation page (--html) applies
+  the same rule when a keypoint is clicked away.
+  eps_oc / delta_nd default to 3%d / 1.5%d of the diameter d (kept when editing) and
+  are written as absolute distances.
+More examples:
+  c3po annotate mug.obj --auto 8 --seed 1 -o mug.json --html mug.html
+  c3po annotate textured.obj -o mug.json --from-json keypoints.json --key farthest8
+  c3po annotate --edit mug.json --remove 3 --drop-sets --keypoint 0.01,0.02,0.1 -o mug.json)";
+
 }  // namespace
 
 RunFunction SetupAnnotate(CLI::App& command) {
   auto options = std::make_shared<AnnotateCommand>();
   Declare(command, *options);
+  command.footer(command.get_footer() + kNotes);
   return [options]() { return Run(*options); };
 }
 

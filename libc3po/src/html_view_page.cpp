@@ -20,6 +20,7 @@ std::string Head(const std::string& title) {
   #view { position: relative; flex: 1; min-width: 200px; overflow: hidden; background: #f4f4f4; }
   #view canvas { display: block; cursor: crosshair; }
   #labels { position: absolute; inset: 0; pointer-events: none; }
+  .label.hidden-behind { opacity: 0.35; }
   .label { position: absolute; transform: translate(8px, -50%); white-space: nowrap;
            font-size: 12px; padding: 0 3px; border-radius: 3px; background: rgba(255,255,255,.8); }
   #panel { width: 340px; overflow-y: auto; padding: 10px 14px; border-left: 1px solid #ccc; background: #fff; }
@@ -44,6 +45,7 @@ std::string Head(const std::string& title) {
   <p class="info">Drag: rotate &middot; right-drag or shift-drag: pan &middot; wheel: zoom.<br>
   Click the surface to add a keypoint; click a keypoint to remove it (indicator sets that
   contain it are dropped, the others renumbered).</p>
+  <button id="up-axis" title="which model axis points up on screen">Up axis: Z</button>
   <h2 id="count"></h2>
   <ul id="keypoint-list"></ul>
   <h2>Indicator sets</h2>
@@ -236,17 +238,30 @@ function makeView(THREE) {
   const radius = diameter * 0.012;
   const sphere = new THREE.SphereGeometry(radius, 20, 14);
 
-  // Orbit camera: spherical angles about `target` (+y up).
-  const orbit = {theta: 0.7, phi: 1.1, distance: 2.2 * diameter};
+  // Orbit camera: spherical angles about `target`; the model's +z (robotics,
+  // YCB) or +y (graphics, ShapeNet) axis points up on screen.
+  const orbit = {theta: 0.7, phi: 1.1, distance: 2.2 * diameter, up: 'z'};
   function placeCamera() {
     const s = Math.sin(orbit.phi);
-    camera.position.set(target.x + orbit.distance * s * Math.sin(orbit.theta),
-                        target.y + orbit.distance * Math.cos(orbit.phi),
-                        target.z + orbit.distance * s * Math.cos(orbit.theta));
-    camera.up.set(0, 1, 0);
+    const side = orbit.distance * s * Math.sin(orbit.theta);
+    const up = orbit.distance * Math.cos(orbit.phi);
+    const front = orbit.distance * s * Math.cos(orbit.theta);
+    if (orbit.up === 'y') {
+      camera.position.set(target.x + side, target.y + up, target.z + front);
+      camera.up.set(0, 1, 0);
+    } else {
+      camera.position.set(target.x + side, target.y - front, target.z + up);
+      camera.up.set(0, 0, 1);
+    }
     camera.lookAt(target);
     camera.updateMatrixWorld();
   }
+  const upButton = document.getElementById('up-axis');
+  upButton.addEventListener('click', () => {
+    orbit.up = orbit.up === 'z' ? 'y' : 'z';
+    upButton.textContent = 'Up axis: ' + orbit.up.toUpperCase();
+    requestRender();
+  });
   function pan(dx, dy) {
     const scale = orbit.distance * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) * 2 / canvas.clientHeight;
     const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
@@ -267,6 +282,22 @@ function makeView(THREE) {
       renderer.render(scene, camera);
       updateLabels();
       resolveFirst();
+      clearTimeout(occlusionTimer);
+      occlusionTimer = setTimeout(markHiddenLabels, 150);
+    });
+  }
+  // Labels of keypoints behind the surface are dimmed (once the view is still).
+  let occlusionTimer = 0;
+  function markHiddenLabels() {
+    const ray = new THREE.Raycaster();
+    state.keypoints.forEach((p, i) => {
+      if (!labels[i]) return;
+      const point = new THREE.Vector3(p[0], p[1], p[2]);
+      const toPoint = point.clone().sub(camera.position);
+      const distance = toPoint.length();
+      ray.set(camera.position, toPoint.normalize());
+      ray.far = distance - radius;
+      labels[i].classList.toggle('hidden-behind', ray.intersectObject(surface, false).length > 0);
     });
   }
   function toPixel(p) {
