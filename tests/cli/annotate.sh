@@ -47,22 +47,23 @@ grep -q '"auto0"' box.json || fail "auto keypoint names"
 # Bad input: exit 2, one line on stderr, no output file.
 expect_error() {
   local what=$1; shift
-  rm -f bad.json
+  rm -f bad.json bad.html
   "$C3PO" "$@" > bad.out 2> bad.err
   local status=$?
   [ $status -eq 2 ] || { cat bad.out bad.err; fail "$what: exit $status, expected 2"; }
   # One line (CLI11 usage errors add a "Run with --help" hint).
   [ "$(grep -vc 'Run with --help' bad.err)" -eq 1 ] || { cat bad.err; fail "$what: expected one line on stderr"; }
   [ ! -e bad.json ] || fail "$what: wrote bad.json"
+  [ ! -e bad.html ] || fail "$what: wrote bad.html"
   echo "ok: $what -> $(head -1 bad.err)"
 }
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' > no_faces.obj
 expect_error "non-numeric coordinate" annotate box_mm.obj --units mm -o bad.json --keypoint 0.1,x,0
 expect_error "empty mesh" annotate no_faces.obj -o bad.json --keypoint 0,0,0
 expect_error "missing mesh" annotate nowhere.obj -o bad.json --keypoint 0,0,0
-expect_error "point far from the surface" annotate box_mm.obj --units mm -o bad.json --keypoint 0.1,0.05,0.2
+expect_error "point far from the surface" annotate box_mm.obj --units mm -o bad.json --html bad.html --keypoint 0.1,0.05,0.2
 expect_error "unknown units" annotate box_mm.obj --units inch -o bad.json --keypoint 0,0,0
-expect_error "no keypoints" annotate box_mm.obj -o bad.json
+expect_error "no keypoints" annotate box_mm.obj -o bad.json --html bad.html
 expect_error "remove out of range" annotate --edit box.json --remove 7 -o bad.json
 expect_error "missing --from-json file" annotate box_mm.obj --units mm -o bad.json --from-json none.json --key k
 echo '[{"class_id": "1", "model_id": "m1", "keypoints": [{"xyz": [0, 0, 0], "semantic_id": 1}]}]' > kpnet.json
