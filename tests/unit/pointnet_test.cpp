@@ -74,7 +74,7 @@ std::vector<TrainingSample> ToyDataset(int count, int points, std::uint64_t seed
 // Oracle: the network written out with plain Eigen (double) from the flat
 // weights and their documented layout, on all points of a cloud with <= n points.
 PointSet OracleForward(const PointNetDetector& detector, const PointSet& cloud) {
-  const std::vector<float> weights = detector.Weights();
+  const std::vector<float> weights = detector.GetWeights();
   const auto blocks = detector.WeightBlocks();
   auto matrix = [&](std::size_t b, Eigen::Index rows) {
     const auto& block = blocks[b];
@@ -184,7 +184,7 @@ TEST_CASE("pointnet gradients match central finite differences in every layer") 
   }
   std::vector<double> gradient;
   detector.LossAndGradient(clouds, targets, &gradient);
-  const std::vector<float> weights = detector.Weights();
+  const std::vector<float> weights = detector.GetWeights();
   REQUIRE(gradient.size() == weights.size());
   // The loss is piecewise smooth (ReLU, max): an entry whose one-sided
   // differences disagree straddles a kink and is skipped (at most a few).
@@ -271,7 +271,7 @@ TEST_CASE("pointnet training is deterministic and independent of the thread coun
     auto o = options;
     o.seed = seed;
     detector.Fit(samples, {}, o);
-    return detector.Weights();
+    return detector.GetWeights();
   };
   const auto two = train(2, 11);
   CHECK(train(2, 11) == two);
@@ -291,18 +291,24 @@ TEST_CASE("a resumed checkpoint gives the weights of an uninterrupted run") {
   CHECK_THROWS_AS(interrupted.Fit(samples, {}, options, [](const c3po::EpochLog& log) {
     if (log.epoch == 2) throw c3po::Interrupted();
   }), c3po::Interrupted);
-  auto resumed = PointNetDetector::LoadCheckpoint(options.checkpoint_path, Identity("toy", 2));
+  PointNetDetector resumed(Identity("toy", 2), SmallArchitecture(32), 99);
+  CHECK(resumed.LoadCheckpoint(options.checkpoint_path).empty());
   options.resume = true;
   std::vector<int> epochs_run;
-  const auto rest = resumed->Fit(samples, {}, options, [&](const c3po::EpochLog& log) {
+  const auto rest = resumed.Fit(samples, {}, options, [&](const c3po::EpochLog& log) {
     epochs_run.push_back(log.epoch);
   });
   CHECK(epochs_run == std::vector<int>{3, 4});
-  CHECK(resumed->Weights() == uninterrupted.Weights());
+  CHECK(resumed.GetWeights() == uninterrupted.GetWeights());
   REQUIRE(rest.epochs.size() == full.epochs.size());
   CHECK(rest.epochs.back().val_loss == full.epochs.back().val_loss);
   CHECK(rest.best_epoch == full.best_epoch);
-  CHECK_THROWS_AS(PointNetDetector::LoadCheckpoint(dir / "missing.ckpt", Identity("toy", 2)), c3po::InputError);
+  CHECK_THROWS_AS(resumed.LoadCheckpoint(dir / "missing.ckpt"), c3po::InputError);
+  // The caller's state travels with the checkpoint; another architecture is refused.
+  resumed.SaveCheckpoint(dir / "state.ckpt", R"({"epoch": 7})");
+  CHECK(resumed.LoadCheckpoint(dir / "state.ckpt") == R"({"epoch": 7})");
+  PointNetDetector other_shape(Identity("toy", 2), SmallArchitecture(16), 4);
+  CHECK_THROWS_AS(other_shape.LoadCheckpoint(dir / "state.ckpt"), c3po::InputError);
 }
 
 TEST_CASE("pointnet model files: round trip, wrong object, truncated and corrupt files") {
@@ -311,10 +317,12 @@ TEST_CASE("pointnet model files: round trip, wrong object, truncated and corrupt
   PointNetDetector detector(Identity("box", 3, 0.3), SmallArchitecture(32), 6);
   detector.set_training_info_json(R"({"note": "unit test"})");
   const std::string path = dir / "model.c3po";
-  detector.Save(path);
+  detector.Save(path, R"({"selftrained": true})");
+  CHECK_THROWS_AS(detector.Save(dir / "x.c3po", R"({"object": "mug"})"), std::invalid_argument);
+  CHECK(ReadBytes(path).find("\"selftrained\":true") != std::string::npos);
 
   const auto loaded = PointNetDetector::Load(path, Identity("box", 3, 0.3));
-  CHECK(loaded->Weights() == detector.Weights());
+  CHECK(loaded->GetWeights() == detector.GetWeights());
   std::vector<PointSet> clouds = {RandomPoints(100, &rng), RandomPoints(20, &rng)};
   CHECK(loaded->DetectBatch(clouds) == detector.DetectBatch(clouds));
   CHECK(loaded->training_info_json().find("unit test") != std::string::npos);
@@ -333,7 +341,7 @@ TEST_CASE("pointnet model files: round trip, wrong object, truncated and corrupt
   PointNetIdentity same_name_other_keypoints = Identity("box", 3);
   same_name_other_keypoints.keypoint_hash = "different";
   CHECK_THROWS_AS(PointNetDetector::Load(path, same_name_other_keypoints), c3po::InputError);
-  CHECK_THROWS_AS(PointNetDetector::LoadCheckpoint(path, Identity("box", 3)), c3po::InputError);
+  CHECK_THROWS_AS(detector.LoadCheckpoint(path), c3po::InputError);   // a model, not a checkpoint
 
   // Truncated at every interesting length, corrupted bytes, garbage, missing.
   const std::string bytes = ReadBytes(path);

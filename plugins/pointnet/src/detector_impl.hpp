@@ -32,6 +32,8 @@ struct PointNetDetector::Impl {
   double optimizer_momentum = 0.0;
   PointNetProgress progress;
   std::string training_info = "{}";
+  PointNetTrainOptions step_options;                      // for TrainStep(clouds, targets)
+  std::string checkpoint_state;                           // state_json of the loaded checkpoint
 
   // Inference copies of `network` (Detect may run on several threads).
   mutable std::mutex pool_mutex;

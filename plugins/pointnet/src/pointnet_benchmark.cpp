@@ -80,7 +80,7 @@ PointNetBenchmarkResult RunPointNetBenchmark(const PointNetBenchmarkOptions& opt
 
   PointNetBenchmarkResult result;
   result.threads = options.threads > 0 ? options.threads : DefaultThreadCount();
-  result.parameters = detector.Weights().size();
+  result.parameters = detector.GetWeights().size();
   const Rate train = Measure(options.seconds, options.batch, [&] {
     detector.TrainStep(train_clouds, targets, train_options);
   });

@@ -52,6 +52,7 @@ PointNetDetector::Impl::Impl(const PointNetIdentity& id, const PointNetArchitect
     : identity(id), architecture(arch) {
   identity.Check();
   architecture.Check();
+  step_options.num_points = architecture.num_points;
   network = std::make_unique<pointnet::PointNetwork>(Shape(), seed, threads);
 }
 
@@ -167,7 +168,7 @@ std::vector<PointNetDetector::WeightBlock> PointNetDetector::WeightBlocks() cons
   return blocks;
 }
 
-std::vector<float> PointNetDetector::Weights() const { return impl_->network->Weights(); }
+std::vector<float> PointNetDetector::GetWeights() const { return impl_->network->Weights(); }
 
 void PointNetDetector::SetWeights(const std::vector<float>& weights) {
   impl_->network->SetWeights(weights);

@@ -63,7 +63,8 @@ void CheckFinite(const std::vector<float>& values, const std::string& path, cons
   }
 }
 
-std::string Compose(const PointNetDetector::Impl& impl, bool checkpoint) {
+std::string Compose(const PointNetDetector::Impl& impl, bool checkpoint, const std::string& extra_json,
+                    const std::string& state_json) {
   const std::vector<float> weights = impl.network->Weights();
   json header = {{"detector", "pointnet"},
                  {"kind", checkpoint ? "checkpoint" : "model"},
@@ -95,6 +96,23 @@ std::string Compose(const PointNetDetector::Impl& impl, bool checkpoint) {
                           {"best_weights", p.best_weights.size()},
                           {"history", history}};
     binary.Floats(p.best_weights);
+    header["state"] = state_json;
+  }
+  if (!extra_json.empty()) {
+    json extra;
+    try {
+      extra = json::parse(extra_json);
+    } catch (const json::exception& e) {
+      throw std::invalid_argument(std::string("header extra is not JSON: ") + e.what());
+    }
+    if (!extra.is_object()) throw std::invalid_argument("header extra must be a JSON object");
+    for (auto it = extra.begin(); it != extra.end(); ++it) {
+      if (header.contains(it.key()) || it.key() == "magic" || it.key() == "format_version" ||
+          it.key() == "binary") {
+        throw std::invalid_argument("header extra may not redefine \"" + it.key() + "\"");
+      }
+      header[it.key()] = it.value();
+    }
   }
   return pointnet::ComposeModelFile(header, binary.bytes());
 }
@@ -123,6 +141,9 @@ void RestoreCheckpoint(const json& header, pointnet::BinaryReader* reader, const
                           : std::numeric_limits<double>::infinity();
     for (const auto& log : progress.at("history")) p.history.push_back(EpochFromJson(log));
     p.best_weights = reader->Floats(progress.at("best_weights").get<std::size_t>(), "best weights");
+    if (header.contains("state") && header["state"].is_string()) {
+      impl->checkpoint_state = header["state"].get<std::string>();
+    }
     CheckFinite(p.best_weights, path, "best weights");
   } catch (const json::exception& e) {
     throw InputError(path, std::string("corrupt checkpoint header: ") + e.what());
@@ -133,22 +154,17 @@ void RestoreCheckpoint(const json& header, pointnet::BinaryReader* reader, const
 
 }  // namespace
 
-void PointNetDetector::Save(const std::string& path) const {
-  WriteFileAtomically(path, Compose(*impl_, /*checkpoint=*/false));
+void PointNetDetector::Save(const std::string& path, const std::string& header_extra_json) const {
+  WriteFileAtomically(path, Compose(*impl_, /*checkpoint=*/false, header_extra_json, ""));
 }
 
-void PointNetDetector::SaveCheckpoint(const std::string& path) const {
-  WriteFileAtomically(path, Compose(*impl_, /*checkpoint=*/true));
+void PointNetDetector::SaveCheckpoint(const std::string& path, const std::string& state_json) const {
+  WriteFileAtomically(path, Compose(*impl_, /*checkpoint=*/true, "", state_json));
 }
 
 std::unique_ptr<PointNetDetector> PointNetDetector::Load(const std::string& path,
                                                          const ObjectModel& object) {
   return Load(path, PointNetIdentity::ForObject(object));
-}
-
-std::unique_ptr<PointNetDetector> PointNetDetector::LoadCheckpoint(const std::string& path,
-                                                                   const ObjectModel& object) {
-  return LoadCheckpoint(path, PointNetIdentity::ForObject(object));
 }
 
 namespace {
@@ -217,9 +233,17 @@ std::unique_ptr<PointNetDetector> PointNetDetector::Load(const std::string& path
   return std::unique_ptr<PointNetDetector>(new PointNetDetector(LoadImpl(path, expected, false)));
 }
 
-std::unique_ptr<PointNetDetector> PointNetDetector::LoadCheckpoint(const std::string& path,
-                                                                   const PointNetIdentity& expected) {
-  return std::unique_ptr<PointNetDetector>(new PointNetDetector(LoadImpl(path, expected, true)));
+std::string PointNetDetector::LoadCheckpoint(const std::string& path) {
+  std::unique_ptr<Impl> loaded = LoadImpl(path, impl_->identity, true);
+  const PointNetArchitecture& a = loaded->architecture;
+  const PointNetArchitecture& b = impl_->architecture;
+  if (a.num_points != b.num_points || a.point_mlp != b.point_mlp || a.head != b.head) {
+    throw InputError(path, "checkpoint has another network architecture than this detector");
+  }
+  loaded->threads = impl_->threads;
+  loaded->step_options = impl_->step_options;
+  impl_ = std::move(loaded);
+  return impl_->checkpoint_state;
 }
 
 }  // namespace c3po

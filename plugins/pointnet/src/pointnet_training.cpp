@@ -125,6 +125,18 @@ double PointNetDetector::TrainStep(const std::vector<PointSet>& clouds,
   return StepOnPrepared(impl_.get(), inputs, targets) * scale * scale;
 }
 
+double PointNetDetector::TrainStep(const std::vector<PointSet>& clouds,
+                                   const std::vector<PointSet>& targets) {
+  return TrainStep(clouds, targets, impl_->step_options);
+}
+
+void PointNetDetector::SetTrainOptions(const PointNetTrainOptions& options) {
+  options.Check();
+  impl_->step_options = options;
+}
+
+const PointNetTrainOptions& PointNetDetector::train_options() const { return impl_->step_options; }
+
 PointNetDetector::Evaluation PointNetDetector::Evaluate(const std::vector<TrainingSample>& samples) const {
   Evaluation evaluation;
   if (samples.empty()) {
@@ -149,7 +161,8 @@ PointNetDetector::Evaluation PointNetDetector::Evaluate(const std::vector<Traini
 
 PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train,
                                         const std::vector<TrainingSample>& validation,
-                                        const PointNetTrainOptions& options, const EpochCallback& on_epoch) {
+                                        const PointNetTrainOptions& options,
+                                        const PointNetEpochCallback& on_epoch) {
   options.Check();
   Impl& impl = *impl_;
   if (options.num_points != impl.architecture.num_points) {
@@ -210,7 +223,7 @@ PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train
     log.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     impl.progress.epochs_done = epoch;
     impl.progress.history.push_back(log);
-    if (!options.checkpoint_path.empty()) SaveCheckpoint(options.checkpoint_path);
+    if (!options.checkpoint_path.empty()) SaveCheckpoint(options.checkpoint_path, "");
     if (on_epoch) on_epoch(log);
   }
 

@@ -102,9 +102,9 @@ struct PointNetFitResult {
   std::size_t validation_samples = 0;
 };
 
-using EpochCallback = std::function<void(const EpochLog&)>;
+using PointNetEpochCallback = std::function<void(const EpochLog&)>;
 
-class PointNetDetector : public Detector {
+class PointNetDetector : public TrainableDetector {
  public:
   // A freshly initialised network (weights drawn from `seed`).
   explicit PointNetDetector(const ObjectModel& object, const PointNetArchitecture& architecture = {},
@@ -131,7 +131,8 @@ class PointNetDetector : public Detector {
   // calls ThrowIfInterrupted().
   PointNetFitResult Fit(const std::vector<TrainingSample>& train,
                         const std::vector<TrainingSample>& validation,
-                        const PointNetTrainOptions& options, const EpochCallback& on_epoch = {});
+                        const PointNetTrainOptions& options,
+                        const PointNetEpochCallback& on_epoch = {});
 
   // One optimisation step on a batch (self-training: regress onto the
   // corrected keypoints of certified samples). Clouds are prepared as in
@@ -140,6 +141,11 @@ class PointNetDetector : public Detector {
   // the batch's mean squared keypoint error before the step (object units^2).
   double TrainStep(const std::vector<PointSet>& clouds, const std::vector<PointSet>& keypoints,
                    const PointNetTrainOptions& options);
+  // TrainableDetector: the same with the options of SetTrainOptions (default:
+  // PointNetTrainOptions{} with the network's num_points).
+  double TrainStep(const std::vector<PointSet>& clouds, const std::vector<PointSet>& targets) override;
+  void SetTrainOptions(const PointNetTrainOptions& options);   // calls options.Check()
+  const PointNetTrainOptions& train_options() const;
   // Mean squared keypoint error and mean keypoint distance on a set, no training.
   struct Evaluation {
     double loss = 0.0;
@@ -147,18 +153,21 @@ class PointNetDetector : public Detector {
   };
   Evaluation Evaluate(const std::vector<TrainingSample>& samples) const;
 
-  // Model file (atomic write; format above). Load throws InputError("path:
-  // ...") for unreadable, truncated, corrupt or foreign files.
-  void Save(const std::string& path) const;
+  // Model file (atomic write; format above). `header_extra_json` (a JSON
+  // object or "") is merged into the header; it may not redefine the keys
+  // above (std::invalid_argument). Load throws InputError("path: ...") for
+  // unreadable, truncated, corrupt or foreign files.
+  void Save(const std::string& path, const std::string& header_extra_json = "") const override;
   static std::unique_ptr<PointNetDetector> Load(const std::string& path, const ObjectModel& object);
   static std::unique_ptr<PointNetDetector> Load(const std::string& path,
                                                 const PointNetIdentity& expected);
-  // Checkpoint = model + optimiser state + finished epochs + best weights.
-  void SaveCheckpoint(const std::string& path) const;
-  static std::unique_ptr<PointNetDetector> LoadCheckpoint(const std::string& path,
-                                                          const ObjectModel& object);
-  static std::unique_ptr<PointNetDetector> LoadCheckpoint(const std::string& path,
-                                                          const PointNetIdentity& expected);
+  // Checkpoint = model + optimiser state + Fit's progress (finished epochs,
+  // history, best weights) + the caller's `state_json` (stored verbatim).
+  void SaveCheckpoint(const std::string& path, const std::string& state_json = "") const override;
+  // Restores weights, optimiser and progress in place from a checkpoint of
+  // this object and architecture (else InputError naming the file); returns
+  // the state_json saved with it.
+  std::string LoadCheckpoint(const std::string& path) override;
 
   const PointNetIdentity& identity() const;
   const PointNetArchitecture& architecture() const;
@@ -179,8 +188,8 @@ class PointNetDetector : public Detector {
     std::size_t size = 0;
   };
   std::vector<WeightBlock> WeightBlocks() const;
-  std::vector<float> Weights() const;
-  void SetWeights(const std::vector<float>& weights);
+  std::vector<float> GetWeights() const override;
+  void SetWeights(const std::vector<float>& weights) override;   // std::invalid_argument on size mismatch
   // Loss (normalised units, as trained) and its gradient with respect to the
   // flat weights, on clouds prepared as in Detect; for gradient checks.
   double LossAndGradient(const std::vector<PointSet>& clouds, const std::vector<PointSet>& keypoints,
