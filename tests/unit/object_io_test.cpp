@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <tuple>
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -189,4 +191,27 @@ TEST_CASE("ParseThreshold: absolute, percent of the diameter, mm, cm") {
   }
   // A percentage needs a positive diameter.
   ExpectInputError([&] { c3po::ParseThreshold("3%d", 0.0, "--eps-oc"); }, "--eps-oc", "");
+}
+
+TEST_CASE("the CLI turns malformed object and mesh files into exit status 2 and one line") {
+  c3po::test::TempDir dir("object_io_cli");
+  // (command, file the message must name, field it must name)
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+      {"indicators " + Fixture("bad_indicator_out_of_range.json"), Fixture("bad_indicator_out_of_range.json"), "indicator_sets"},
+      {"indicators " + Fixture("bad_keypoint_nan_string.json"), Fixture("bad_keypoint_nan_string.json"), "keypoints"},
+      {"indicators " + Fixture("bad_not_json.json"), Fixture("bad_not_json.json"), ""},
+      {"indicators " + Fixture("bad_keypoint_overflow.json"), Fixture("bad_keypoint_overflow.json"), ""},
+      {"annotate " + Fixture("only_vertices.obj") + " --keypoint 0,0,0 -o " + dir / "out.json", Fixture("only_vertices.obj"), ""},
+      {"annotate " + dir / "missing.obj" + " --keypoint 0,0,0 -o " + dir / "out.json", dir / "missing.obj", ""},
+  };
+  for (const auto& [args, file, field] : cases) {
+    CAPTURE(args);
+    const auto result = c3po::test::RunC3po(args);
+    CAPTURE(result.output);
+    CHECK(result.status == 2);
+    CHECK(result.output.find(file) != std::string::npos);
+    CHECK(result.output.find(field) != std::string::npos);
+    CHECK(std::count(result.output.begin(), result.output.end(), '\n') == 1);
+  }
+  CHECK_FALSE(fs::exists(dir / "out.json"));  // nothing written on failure
 }
