@@ -419,3 +419,80 @@ TEST_CASE("ClosestSurfacePoint of a box equals the analytic distance") {
   CHECK(none.triangle == -1);
   CHECK(std::isinf(none.distance));
 }
+
+TEST_CASE("several meshes in one file are merged with correct vertex offsets") {
+  // Two boxes as separate OBJ objects with different materials: assimp returns
+  // two meshes whose indices must be shifted when merged.
+  c3po::test::TempDir dir("mesh_merge");
+  std::ostringstream out;
+  const Eigen::Vector3d shift(10, 0, 0);
+  for (int copy = 0; copy < 2; ++copy) {
+    out << "o box" << copy << "\nusemtl material" << copy << '\n';
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d v = Corner(i) + copy * shift;
+      out << "v " << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
+    }
+    for (const auto& q : kQuads) {
+      out << "f";
+      for (int k = 0; k < 4; ++k) out << ' ' << q[k] + 1 + 8 * copy;
+      out << '\n';
+    }
+  }
+  WriteText(dir / "two_boxes.obj", out.str());
+  const Mesh mesh = c3po::LoadMesh(dir / "two_boxes.obj");
+  CHECK(mesh.triangles.cols() == 24);
+  CHECK(mesh.SurfaceArea() == doctest::Approx(2 * kBoxArea));
+  CHECK((mesh.BoundingBox().min() - kLo).norm() < 1e-9);
+  CHECK((mesh.BoundingBox().max() - (kLo + kSize + shift)).norm() < 1e-9);
+  // Every triangle is a face of one of the two boxes: its vertices share one
+  // coordinate that lies on a face plane of that box.
+  int on_second_box = 0;
+  for (int t = 0; t < 24; ++t) {
+    Eigen::Matrix3d corners;
+    for (int k = 0; k < 3; ++k) corners.col(k) = mesh.vertices.col(mesh.triangles(k, t));
+    const Eigen::Vector3d local = corners.col(0) - (corners(0, 0) > 5 ? shift : Eigen::Vector3d::Zero());
+    CHECK((corners.rowwise().maxCoeff() - corners.rowwise().minCoeff()).minCoeff() == 0.0);
+    CHECK(((local - kLo).cwiseAbs().minCoeff() < 1e-12 || (local - kLo - kSize).cwiseAbs().minCoeff() < 1e-12));
+    on_second_box += corners.row(0).minCoeff() > 5 ? 1 : 0;
+    CHECK((corners.row(0).minCoeff() > 5) == (corners.row(0).maxCoeff() > 5));  // not spanning both
+  }
+  CHECK(on_second_box == 12);
+}
+
+TEST_CASE("zero-area triangles are never sampled") {
+  Mesh mesh = BoxMesh();
+  const int proper = static_cast<int>(mesh.triangles.cols());
+  mesh.triangles.conservativeResize(3, proper + 3);
+  mesh.triangles.col(proper) = Eigen::Vector3i(0, 0, 1);      // two equal corners
+  mesh.triangles.col(proper + 1) = Eigen::Vector3i(3, 3, 3);  // a point
+  mesh.triangles.col(proper + 2) = Eigen::Vector3i(0, 1, 1);  // last in the area table
+  CHECK(mesh.SurfaceArea() == doctest::Approx(kBoxArea));
+  const auto sample = c3po::SampleSurfaceWithTriangles(mesh, 20000, 11);
+  CHECK(sample.triangle.maxCoeff() < proper);
+  CHECK(sample.points.allFinite());
+}
+
+TEST_CASE("Pose composition, inverse and application agree") {
+  c3po::Rng rng(45);
+  for (int trial = 0; trial < 50; ++trial) {
+    c3po::Pose a, b;
+    a.R = rng.Rotation();
+    b.R = rng.Rotation();
+    a.t = rng.UnitVector() * rng.Uniform(0, 3);
+    b.t = rng.UnitVector() * rng.Uniform(0, 3);
+    PointSet points(3, 10);
+    for (int i = 0; i < 10; ++i) points.col(i) = rng.UnitVector() * rng.Uniform(0, 2);
+    CHECK(((a * b) * points - a * (b * points)).norm() < 1e-12);
+    CHECK((a.Inverse() * (a * points) - points).norm() < 1e-12);
+    CHECK((a.InverseApply(points) - a.Inverse() * points).norm() < 1e-12);
+    const c3po::Pose identity = a * a.Inverse();
+    CHECK((identity.R - Eigen::Matrix3d::Identity()).norm() < 1e-12);
+    CHECK(identity.t.norm() < 1e-12);
+    const Eigen::Vector3d x = points.col(3);
+    CHECK((a * x - (a.R * x + a.t)).norm() < 1e-15);
+  }
+  c3po::Pose bad;
+  bad.t(1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(bad.IsFinite());
+  CHECK(c3po::Pose::Identity().IsFinite());
+}

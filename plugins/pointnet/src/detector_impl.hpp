@@ -23,6 +23,10 @@ struct PointNetProgress {
 };
 
 struct PointNetDetector::Impl {
+  struct InferenceCopy {
+    std::unique_ptr<pointnet::PointNetwork> network;
+    std::uint64_t version = 0;
+  };
   PointNetIdentity identity;
   PointNetArchitecture architecture;
   int threads = 0;
@@ -37,14 +41,15 @@ struct PointNetDetector::Impl {
 
   // Inference copies of `network` (Detect may run on several threads).
   mutable std::mutex pool_mutex;
-  mutable std::vector<std::unique_ptr<pointnet::PointNetwork>> pool;
+  mutable std::vector<InferenceCopy> pool;
+  std::uint64_t weights_version = 0;      // copies made from older weights are dropped
 
   Impl(const PointNetIdentity& id, const PointNetArchitecture& arch, std::uint64_t seed);
   pointnet::NetworkShape Shape() const;
   // Call after any change of `network`'s weights.
   void WeightsChanged();
-  std::unique_ptr<pointnet::PointNetwork> AcquireInferenceNetwork() const;
-  void ReleaseInferenceNetwork(std::unique_ptr<pointnet::PointNetwork> network) const;
+  InferenceCopy AcquireInferenceNetwork() const;
+  void ReleaseInferenceNetwork(InferenceCopy copy) const;
   // Forward pass of prepared clouds (any count; chunks of 64).
   std::vector<PointSet> DetectAll(const std::vector<PointSet>& clouds) const;
   // Builds the optimiser if there is none or its settings differ.

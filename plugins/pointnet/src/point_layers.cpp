@@ -27,8 +27,9 @@ std::vector<tiny_dnn::vector_type> InputTypes(std::size_t num_layers) {
   return types;
 }
 
-// Runs body(sample) for every sample, the samples split into one contiguous
-// block per thread; `setup` builds per-thread scratch once per block.
+// Runs body(sample, &scratch) for every sample, the samples split into one
+// contiguous block per thread, each block with its own Scratch (buffers reused
+// from sample to sample).
 template <typename Scratch, typename Body>
 void ForEachSampleBlock(int samples, int threads, const Body& body) {
   const int blocks = std::max(1, std::min(samples, threads > 0 ? threads : DefaultThreadCount()));

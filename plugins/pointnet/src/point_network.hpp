@@ -1,7 +1,7 @@
 #pragma once
 // The PointNet keypoint regressor as a tiny-dnn network:
-//   per-point MLP 3 -> m1 -> ... -> mk (PointwiseDenseLayer, ReLU)
-//   -> max over points (MaxOverPointsLayer)
+//   per-point MLP 3 -> m1 -> ... -> mk (ReLU) and max over points
+//   (PointEncoderLayer, a custom tiny-dnn layer, point_layers.hpp)
 //   -> fully connected head mk -> h1 -> ... (tiny-dnn fully_connected_layer, ReLU)
 //   -> 3N outputs (fully_connected_layer, identity).
 // tiny-dnn carries the graph (edges, per-sample tensors), the fully connected

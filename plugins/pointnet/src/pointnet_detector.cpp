@@ -68,24 +68,26 @@ pointnet::NetworkShape PointNetDetector::Impl::Shape() const {
 void PointNetDetector::Impl::WeightsChanged() {
   std::lock_guard<std::mutex> lock(pool_mutex);
   pool.clear();
+  ++weights_version;
 }
 
-std::unique_ptr<pointnet::PointNetwork> PointNetDetector::Impl::AcquireInferenceNetwork() const {
+PointNetDetector::Impl::InferenceCopy PointNetDetector::Impl::AcquireInferenceNetwork() const {
   std::lock_guard<std::mutex> lock(pool_mutex);
   if (!pool.empty()) {
-    auto copy = std::move(pool.back());
+    InferenceCopy copy = std::move(pool.back());
     pool.pop_back();
     return copy;
   }
-  auto copy = std::make_unique<pointnet::PointNetwork>(Shape(), 0, threads);
-  copy->SetWeights(network->Weights());
+  InferenceCopy copy;
+  copy.network = std::make_unique<pointnet::PointNetwork>(Shape(), 0, threads);
+  copy.network->SetWeights(network->Weights());
+  copy.version = weights_version;
   return copy;
 }
 
-void PointNetDetector::Impl::ReleaseInferenceNetwork(
-    std::unique_ptr<pointnet::PointNetwork> copy) const {
+void PointNetDetector::Impl::ReleaseInferenceNetwork(InferenceCopy copy) const {
   std::lock_guard<std::mutex> lock(pool_mutex);
-  pool.push_back(std::move(copy));
+  if (copy.version == weights_version) pool.push_back(std::move(copy));
 }
 
 std::vector<PointSet> PointNetDetector::Impl::DetectAll(const std::vector<PointSet>& clouds) const {
@@ -102,7 +104,7 @@ std::vector<PointSet> PointNetDetector::Impl::DetectAll(const std::vector<PointS
     }, count > 1 ? threads : 1);
     tiny_dnn::tensor_t inputs(static_cast<std::size_t>(count));
     for (int i = 0; i < count; ++i) inputs[static_cast<std::size_t>(i)] = std::move(prepared[static_cast<std::size_t>(i)].points);
-    const tiny_dnn::tensor_t outputs = copy->Forward(inputs);
+    const tiny_dnn::tensor_t outputs = copy.network->Forward(inputs);
     for (int i = 0; i < count; ++i) {
       keypoints[static_cast<std::size_t>(begin + i)] = pointnet::DenormaliseKeypoints(
           outputs[static_cast<std::size_t>(i)], prepared[static_cast<std::size_t>(i)].centroid, identity.scale);
