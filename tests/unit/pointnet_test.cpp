@@ -11,6 +11,7 @@
 
 #include "c3po/error.hpp"
 #include "c3po/interrupt.hpp"
+#include "c3po/object_io.hpp"
 #include "c3po/random.hpp"
 #include "test_helpers.hpp"
 
@@ -364,6 +365,29 @@ TEST_CASE("pointnet model files: round trip, wrong object, truncated and corrupt
   WriteBytes(broken, std::string(5000, '\xff'));
   CHECK_THROWS_AS(PointNetDetector::Load(broken, Identity("box", 3)), c3po::InputError);
   CHECK_THROWS_AS(PointNetDetector::Load(dir / "absent.c3po", Identity("box", 3)), c3po::InputError);
+}
+
+TEST_CASE("pointnet models of bundled objects load only for their object") {
+  c3po::test::TempDir dir("pointnet_objects");
+  c3po::ObjectModelOptions sample;
+  sample.sample_size = 500;
+  const c3po::ObjectModel mug = c3po::LoadObject(c3po::test::SourceDir() + "/annotations/mug.json", sample);
+  const c3po::ObjectModel box = c3po::LoadObject(c3po::test::SourceDir() + "/annotations/box.json", sample);
+  PointNetArchitecture architecture = SmallArchitecture(32);
+  PointNetDetector detector(mug, architecture, 3);
+  CHECK(detector.identity().scale == mug.diameter());
+  CHECK(detector.num_keypoints() == mug.num_keypoints());
+  const std::string path = dir / "mug.c3po";
+  detector.Save(path);
+  CHECK(PointNetDetector::Load(path, mug)->GetWeights() == detector.GetWeights());
+  try {
+    PointNetDetector::Load(path, box);
+    FAIL("a mug model loaded for the box");
+  } catch (const c3po::InputError& e) {
+    const std::string message = e.what();
+    CHECK(message.find(path + ": trained for object '" + mug.name() + "' (keypoint hash " +
+                       mug.KeypointHash() + "), not '" + box.name() + "'") == 0);
+  }
 }
 
 TEST_CASE("pointnet options reject nonsense") {
