@@ -31,6 +31,24 @@ cmp -s depth_a/manifest.jsonl depth_c/manifest.jsonl && fail "different seeds ga
 grep -qa "element vertex 321" sim/000004.ply || fail "sim cloud should have 321 points"
 grep -q '"visible"' sim/manifest.jsonl && fail "sim manifest should not claim visibility"
 
+# Easy poses, a custom camera and distance range.
+"$C3PO" synth "$SOURCE/annotations/drill.json" -o easy --kind depth --count 4 --points 500 \
+  --pose easy --intrinsics 600,600,159.5,119.5,320,240 --distance 0.8,1.0 > out_easy.log 2>&1 \
+  || { cat out_easy.log; fail "synth --pose easy --intrinsics"; }
+grep -q "object centre depth in \[0.8, 1\] m" out_easy.log || { cat out_easy.log; fail "distance range not reported"; }
+
+# A YCB mesh with keypoints imported by c3po annotate (when the shared data is there).
+YCB="$SOURCE/../shared/data/ycb/035_power_drill"
+if [ -f "$YCB/textured.obj" ]; then
+  "$C3PO" annotate "$YCB/textured.obj" -o ycb_drill.json --from-json "$YCB/keypoints.json" \
+    --key farthest8 > out_ycb.log 2>&1 || { cat out_ycb.log; fail "annotate the YCB drill"; }
+  "$C3PO" synth ycb_drill.json -o ycb_depth --kind depth --count 6 --noise 1mm --dropout 0.1 \
+    > out_ycb.log 2>&1 || { cat out_ycb.log; fail "synth on the YCB drill"; }
+  [ "$(wc -l < ycb_depth/manifest.jsonl)" -eq 6 ] || fail "YCB dataset should have 6 clouds"
+else
+  echo "note: $YCB not found, YCB part skipped"
+fi
+
 # Bad inputs: exit 2, one line on stderr naming the problem, no dataset.
 expect_error() {   # expect_error OUTPUT_DIR PATTERN ARGS...
   local out=$1 pattern=$2; shift 2
