@@ -52,7 +52,8 @@ std::vector<Eigen::Index> SelectInliers(const Correspondences& pairs, const IcpO
   std::vector<Eigen::Index> inliers;
   inliers.reserve(pairs.squared_distance.size());
   for (Eigen::Index i = 0; i < pairs.squared_distance.size(); ++i) {
-    if (pairs.squared_distance(i) <= gate) inliers.push_back(i);
+    // A query the tree could not answer (distance overflow) has no pair.
+    if (pairs.model_index(i) >= 0 && pairs.squared_distance(i) <= gate) inliers.push_back(i);
   }
   if (options.trim_fraction > 0 && !inliers.empty()) {
     const auto keep = static_cast<std::size_t>(
@@ -126,6 +127,10 @@ IcpResult RefineIcp(const ObjectModel& model, const PointSet& scene, const Pose&
     const RegistrationResult step = RegisterPairs(model, points, pairs, inliers);
     if (!step.ok()) {
       result.failure = std::string("correspondences are degenerate: ") + ToString(step.status);
+      break;
+    }
+    if (!step.scene_from_model.IsFinite()) {   // overflow on huge coordinates
+      result.failure = "non-finite pose update";
       break;
     }
     const double moved = (step.scene_from_model.t - result.scene_from_model.t).norm();

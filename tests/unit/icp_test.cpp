@@ -183,6 +183,13 @@ TEST_CASE("ICP on degenerate input is an outcome, not a crash") {
     CHECK(result.scene_points == 298);
     CHECK(std::isfinite(result.rms_after));
   }
+  SUBCASE("huge coordinates") {
+    const PointSet huge = 1e300 * SampleScene(object, 50, 6).points;
+    IcpResult result;
+    CHECK_NOTHROW(result = RefineIcp(object, huge, initial));
+    CHECK(result.scene_from_model.IsFinite());
+    CHECK_FALSE(result.converged);
+  }
   SUBCASE("non-finite initial pose") {
     Pose broken = initial;
     broken.R(0, 0) = nan;

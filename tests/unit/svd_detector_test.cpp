@@ -237,6 +237,9 @@ TEST_CASE("svd detector on degenerate clouds") {
   two(0, 1) = nan;   // a non-finite point is ignored
   CHECK(MaxKeypointError(detector.Detect(two), expected) < 1e-12);
 
+  // Huge coordinates: no crash (the output may overflow).
+  CHECK_NOTHROW(detector.Detect(1e300 * SampleSurface(object.mesh(), 100, 8)));
+
   // Three identical or collinear points: finite output, no crash.
   const PointSet same = point.replicate(1, 3);
   CHECK(detector.Detect(same).allFinite());
