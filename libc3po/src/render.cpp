@@ -42,6 +42,9 @@ void CameraIntrinsics::Check() const {
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
     throw InputError("intrinsics: image size must be between 1 and 16384 pixels");
   }
+  if (static_cast<long long>(width) * height > 50000000LL) {
+    throw InputError("intrinsics: more than 50 megapixels");
+  }
 }
 
 CameraIntrinsics ParseIntrinsics(const std::string& text) {

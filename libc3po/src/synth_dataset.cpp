@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <mutex>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -78,28 +77,37 @@ std::vector<std::unique_ptr<DepthRenderer>> MakeRenderers(const SynthGenerator& 
   return renderers;
 }
 
-SynthReport Summarise(const std::vector<SampleStats>& stats, const SynthGenerator& generator) {
-  SynthReport report;
-  report.count = stats.size();
-  report.distance_range = generator.distance_range();
-  report.diameter = generator.diameter();
-  if (stats.empty()) return report;
-  double points = 0.0, attempts = 0.0, visible = 0.0;
-  report.min_cloud_points = stats.front().points;
-  report.max_cloud_points = stats.front().points;
-  for (const auto& s : stats) {
-    points += s.points;
-    attempts += s.attempts;
-    visible += s.visible_fraction;
-    report.min_cloud_points = std::min(report.min_cloud_points, s.points);
-    report.max_cloud_points = std::max(report.max_cloud_points, s.points);
+// Running sums of the per-sample figures (memory independent of the count).
+class StatsAccumulator {
+ public:
+  void Add(const SampleStats& s) {
+    min_points_ = count_ == 0 ? s.points : std::min(min_points_, s.points);
+    max_points_ = count_ == 0 ? s.points : std::max(max_points_, s.points);
+    ++count_;
+    points_ += s.points;
+    attempts_ += s.attempts;
+    visible_ += s.visible_fraction;
   }
-  const double n = static_cast<double>(stats.size());
-  report.mean_points = points / n;
-  report.mean_attempts = attempts / n;
-  report.visible_keypoint_fraction = visible / n;
-  return report;
-}
+  SynthReport Report(const SynthGenerator& generator) const {
+    SynthReport report;
+    report.count = count_;
+    report.distance_range = generator.distance_range();
+    report.diameter = generator.diameter();
+    if (count_ == 0) return report;
+    const double n = static_cast<double>(count_);
+    report.min_cloud_points = min_points_;
+    report.max_cloud_points = max_points_;
+    report.mean_points = points_ / n;
+    report.mean_attempts = attempts_ / n;
+    report.visible_keypoint_fraction = visible_ / n;
+    return report;
+  }
+
+ private:
+  std::size_t count_ = 0;
+  int min_points_ = 0, max_points_ = 0;
+  double points_ = 0.0, attempts_ = 0.0, visible_ = 0.0;
+};
 
 }  // namespace
 
@@ -115,18 +123,20 @@ SynthReport WriteSynthDataset(const Mesh& mesh, const ObjectSpec& spec,
   auto renderers = MakeRenderers(generator, workers);
   const std::size_t total = static_cast<std::size_t>(options.count);
   const std::size_t batch = static_cast<std::size_t>(workers) * 32;
-  std::vector<SampleStats> stats(total);
+  StatsAccumulator accumulator;
+  std::vector<SampleStats> stats(batch);
   for (std::size_t begin = 0; begin < total; begin += batch) {
     const std::size_t end = std::min(total, begin + batch);
     RunBatch(generator, begin, end, renderers, [&](std::size_t i, const SynthSample& sample) {
-      stats[i] = StatsOf(sample);
+      stats[i - begin] = StatsOf(sample);
       writer.Add(i, EntryOf(sample, i), sample.cloud);   // thread-safe
     });
     ThrowIfInterrupted();
+    for (std::size_t i = begin; i < end; ++i) accumulator.Add(stats[i - begin]);
     if (progress) progress(end, total);
   }
   writer.Commit();
-  SynthReport report = Summarise(stats, generator);
+  SynthReport report = accumulator.Report(generator);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
@@ -137,30 +147,27 @@ SynthBenchmark BenchmarkSynth(const Mesh& mesh, const PointSet& keypoints,
   const int workers = std::max(1, DefaultThreadCount());
   auto renderers = MakeRenderers(generator, workers);
   const std::size_t batch = static_cast<std::size_t>(options.count);
-  std::vector<SampleStats> stats;
-  std::mutex stats_mutex;
+  StatsAccumulator accumulator;
+  std::vector<SampleStats> stats(batch);
   const auto start = std::chrono::steady_clock::now();
   double seconds = 0.0;
   std::size_t begin = 0;
   do {
     RunBatch(generator, begin, begin + batch, renderers,
-             [&](std::size_t, const SynthSample& sample) {
-               const SampleStats s = StatsOf(sample);
-               const std::lock_guard<std::mutex> lock(stats_mutex);
-               stats.push_back(s);
-             });
+             [&](std::size_t i, const SynthSample& sample) { stats[i - begin] = StatsOf(sample); });
     ThrowIfInterrupted();
+    for (const SampleStats& s : stats) accumulator.Add(s);
     begin += batch;
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   } while (seconds < min_seconds);
-  const SynthReport summary = Summarise(stats, generator);
+  const SynthReport summary = accumulator.Report(generator);
   SynthBenchmark result;
   result.kind = options.kind;
-  result.clouds = stats.size();
+  result.clouds = summary.count;
   result.threads = workers;
   result.triangles = static_cast<long>(mesh.triangles.cols());
   result.seconds = seconds;
-  result.clouds_per_second = static_cast<double>(stats.size()) / seconds;
+  result.clouds_per_second = static_cast<double>(summary.count) / seconds;
   result.mean_points = summary.mean_points;
   result.mean_attempts = summary.mean_attempts;
   return result;

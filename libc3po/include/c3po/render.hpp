@@ -25,7 +25,7 @@ struct CameraIntrinsics {
   int width = 640;
   int height = 480;
   // Throws InputError("intrinsics: ...") on non-positive focal lengths or
-  // sizes, sizes above 16384, or non-finite values.
+  // sizes, sizes above 16384 or 50 megapixels, or non-finite values.
   void Check() const;
   // Direction (z = 1) of the ray through image point (u, v).
   Eigen::Vector3d Ray(double u, double v) const {
