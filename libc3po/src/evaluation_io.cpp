@@ -54,6 +54,8 @@ std::string Percent(double absolute, double diameter) {
 std::string SettingsLines(const Evaluation& e) {
   const EvaluationOptions& o = e.options;
   std::ostringstream out;
+  out << "Columns: ADD-S % = threshold score, AUC = ADD-S AUC (0..100), rot err and t err / d = medians, "
+         "% oc / % nd / % cert = certificate rates, false cert = certified with ADD-S >= threshold.\n";
   char line[512];
   std::snprintf(line, sizeof line,
                 "ADD-S variant: %s. Threshold score: ADD-S < %.6g (%s); AUC on [0, %.6g] (%s); d = %.6g.\n",
@@ -136,7 +138,7 @@ json SummaryJson(const RowSummary& s, double diameter) {
 }  // namespace
 
 std::string EvaluationTable(const Evaluation& e) {
-  const std::vector<std::string> header = {"Method", "n", "ADD-S %", "AUC", "rot (deg)", "t / d",
+  const std::vector<std::string> header = {"Method", "n", "ADD-S %", "AUC", "rot err (deg)", "t err / d",
                                            "% oc", "% nd", "% cert", "false cert"};
   std::vector<std::vector<std::string>> cells = {header};
   for (const auto& row : e.rows) cells.push_back(TableCells(row));

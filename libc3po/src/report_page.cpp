@@ -51,6 +51,19 @@ function decode(base64) {
   return new Float32Array(bytes.buffer);   // little-endian float32 xyz
 }
 
+// Test hook (report.measure = true): pixels of the last frame that differ
+// from the background, read right after rendering.
+function countColoured(gl) {
+  const width = gl.drawingBufferWidth, height = gl.drawingBufferHeight;
+  const pixels = new Uint8Array(width * height * 4);
+  gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
+  let count = 0;
+  for (let i = 0; i < pixels.length; i += 4) {
+    if (Math.abs(pixels[i] - 244) + Math.abs(pixels[i + 1] - 244) + Math.abs(pixels[i + 2] - 244) > 30) ++count;
+  }
+  return count;
+}
+
 const colours = {input: 0x1f5fd6, certified: 0x2e8b57, rejected: 0xd04040, truth: 0x888888,
                  keypoints: 0xf58231, detected: 0x911eb4};
 
@@ -85,6 +98,7 @@ function makeViewer(THREE, box) {
     camera.updateProjectionMatrix();
     camera.lookAt(orbit.target);
     renderer.render(scene, camera);
+    if (report.measure) report.coloured = countColoured(renderer.getContext());
     report.frames += 1;
   }
   function request() {

@@ -221,7 +221,7 @@ std::string Render(const Histogram& h) {
   out << "\n<text x=\"" << f.left - 3 << "\" y=\"" << f.top + 8 << "\" text-anchor=\"end\">" << tallest
       << "</text><text x=\"" << f.left - 3 << "\" y=\"" << f.bottom << "\" text-anchor=\"end\">0</text>\n";
   out << "<text x=\"" << f.left << "\" y=\"" << f.bottom + 12 << "\">0</text>"
-      << "<text x=\"" << Fixed(bar_x(bins)) << "\" y=\"" << f.bottom + 12 << "\">&gt;=" << ShortNumber(h.x_max)
+      << "<text x=\"" << f.right << "\" y=\"" << f.bottom + 12 << "\" text-anchor=\"end\">&gt;=" << ShortNumber(h.x_max)
       << "</text>\n";
   out << "<text x=\"" << (f.left + f.right) / 2 << "\" y=\"" << f.bottom + 26 << "\" text-anchor=\"middle\">"
       << Escape(h.x_label) << "</text>\n";

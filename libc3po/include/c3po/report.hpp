@@ -13,7 +13,9 @@
 //     rejected examples: input cloud, posed model sample, ground-truth posed
 //     model sample, detected and output keypoints.
 // Test hooks: document.body.dataset.ready = "1" once the page has set up,
-// window.c3poReport = {views, webgl, shown(i), frames}.
+// window.c3poReport = {views (count), webgl (bool), shown (index), show(i),
+// frames (renders so far), orbit ({theta, phi, distance}), measure (set true
+// to make each render count into `coloured` the non-background pixels)}.
 #include <map>
 #include <string>
 #include <vector>

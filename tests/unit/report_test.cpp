@@ -1,0 +1,273 @@
+// The HTML report: well-formed and self-contained, the table/soundness/plots
+// agree with the evaluation, 3D view data decodes to the selected examples,
+// training logs are read and plotted, and the file is written atomically.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <cstring>
+
+#include "c3po/atomic_file.hpp"
+#include "c3po/error.hpp"
+#include "c3po/evaluation.hpp"
+#include "c3po/report.hpp"
+#include "evaluation_fixture.hpp"
+#include "test_helpers.hpp"
+
+using namespace c3po;
+using namespace c3po::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+// A small HTML checker: doctype first, every element closed in order (void
+// elements and "/>" excepted), script/style bodies skipped, and no attribute
+// src/href pointing anywhere but data: or the page itself. Returns "" when fine.
+std::string CheckHtml(const std::string& html) {
+  static const std::vector<std::string> kVoid = {"meta", "link", "br", "input", "img", "hr",
+                                                 "area", "base", "col", "embed", "source", "wbr"};
+  if (Lower(html.substr(0, 15)) != "<!doctype html>") return "no doctype";
+  std::vector<std::string> open;
+  std::size_t at = 15;
+  while ((at = html.find('<', at)) != std::string::npos) {
+    if (html.compare(at, 4, "<!--") == 0) {
+      at = html.find("-->", at);
+      if (at == std::string::npos) return "unterminated comment";
+      continue;
+    }
+    std::size_t end = at + 1;
+    char quote = 0;
+    for (; end < html.size() && (quote || html[end] != '>'); ++end) {
+      if (quote && html[end] == quote) quote = 0;
+      else if (!quote && (html[end] == '"' || html[end] == '\'')) quote = html[end];
+    }
+    if (end >= html.size()) return "unterminated tag at " + std::to_string(at);
+    const std::string tag = html.substr(at + 1, end - at - 1);
+    at = end + 1;
+    if (tag.empty()) return "empty tag";
+    if (tag[0] == '/') {
+      const std::string name = Lower(tag.substr(1));
+      if (open.empty() || open.back() != name) {
+        return "unexpected </" + name + "> (open: " + (open.empty() ? "none" : open.back()) + ")";
+      }
+      open.pop_back();
+      continue;
+    }
+    const std::string name = Lower(tag.substr(0, tag.find_first_of(" \t\n/")));
+    for (const char* attribute : {" src=\"", " href=\""}) {
+      const std::size_t a = tag.find(attribute);
+      if (a == std::string::npos) continue;
+      const std::string value = tag.substr(a + std::strlen(attribute), 5);
+      if (value.rfind("data:", 0) != 0 && value[0] != '#') return "external reference in <" + tag + ">";
+    }
+    if (tag.back() == '/' || std::find(kVoid.begin(), kVoid.end(), name) != kVoid.end()) continue;
+    if (name == "script" || name == "style") {
+      const std::size_t close = Lower(html.substr(at)).find("</" + name + ">");
+      if (close == std::string::npos) return "unclosed <" + name + ">";
+      at += close + name.size() + 3;
+      continue;
+    }
+    open.push_back(name);
+  }
+  if (!open.empty()) return "unclosed <" + open.back() + ">";
+  return "";
+}
+
+std::string ScriptBody(const std::string& html, const std::string& id) {
+  const std::string start = "id=\"" + id + "\">";
+  const std::size_t a = html.find(start);
+  if (a == std::string::npos) return "";
+  const std::size_t b = html.find("</script>", a);
+  return html.substr(a + start.size(), b - a - start.size());
+}
+
+std::size_t Base64Floats(const std::string& text) {
+  std::size_t padding = 0;
+  if (!text.empty() && text.back() == '=') ++padding;
+  if (text.size() > 1 && text[text.size() - 2] == '=') ++padding;
+  return (text.size() / 4 * 3 - padding) / 4;
+}
+
+struct Fixture {
+  ObjectModel object = EvaluationObject();
+  TempDir dir{"report_test"};
+  Dataset dataset;
+  Evaluation evaluation;
+  Fixture() {
+    WriteEvaluationDataset(object, dir / "data", 8);
+    dataset = ReadDataset(dir / "data");
+    EvaluationOptions options = EvaluationOptions::Defaults(object);
+    options.run_icp = false;
+    evaluation = Evaluate(object, dataset, {{"sim", nullptr, false}, {"self", nullptr, true}}, options);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("the report is well-formed, self-contained HTML with the table, soundness and plots") {
+  Fixture f;
+  ReportInput input;
+  input.evaluation = &f.evaluation;
+  input.views = SelectReportViews(f.object, f.dataset, *f.evaluation.MainRow(),
+                                  f.evaluation.options.adds_threshold, {2, 2, 300});
+  input.command_line = "c3po eval x.json --data <dir> & more";
+  const std::string html = ReportHtml(input);
+  CHECK(CheckHtml(html) == "");
+  // Checker self-test: it notices a broken page.
+  CHECK(CheckHtml(html.substr(0, html.size() / 2)) != "");
+  CHECK(CheckHtml("<!doctype html><html><body><img src=\"https://example.org/x.png\"></body></html>") != "");
+
+  // Outside the embedded three.js source, no URL at all.
+  std::string rest = html;
+  const std::string three = ScriptBody(html, "c3po-three");
+  CHECK(three.size() > 100000);
+  rest.erase(rest.find(three), three.size());
+  CHECK(rest.find("http://") == std::string::npos);
+  CHECK(rest.find("https://") == std::string::npos);
+  CHECK(html.find("<table id=\"results\">") != std::string::npos);
+
+  // One table row per evaluation row (+ header), in order.
+  const std::string table = html.substr(html.find("<table id=\"results\">"));
+  std::size_t rows = 0, pos = 0;
+  while ((pos = table.find("<tr", pos + 1)) != std::string::npos && pos < table.find("</table>")) ++rows;
+  CHECK(rows == f.evaluation.rows.size() + 1);
+  for (const auto& row : f.evaluation.rows) CHECK(table.find(">" + row.label + "<") != std::string::npos);
+  CHECK(html.find("<b id=\"false-certificates\">" + std::to_string(f.evaluation.total_false_certificates()) + "</b>") !=
+        std::string::npos);
+  CHECK(html.find("ADD-S variant: <b>symmetric</b>") != std::string::npos);
+  CHECK(html.find("&lt;dir&gt; &amp; more") != std::string::npos);
+
+  // Histogram bars (titles "certified a - b: N") add up to the samples of each row on all clouds.
+  // (scanned by hand: std::regex recurses per character and overflows the stack on a 1 MB page)
+  int total = 0;
+  for (std::size_t at = html.find("<title>"); at != std::string::npos; at = html.find("<title>", at + 1)) {
+    const std::size_t end = html.find("</title>", at);
+    const std::string text = html.substr(at + 7, end - at - 7);
+    if (text.rfind("certified ", 0) != 0 && text.rfind("not certified ", 0) != 0) continue;
+    total += std::stoi(text.substr(text.rfind(": ") + 2));
+  }
+  int expected = 0;
+  for (const auto& row : f.evaluation.rows) expected += row.subset == EvalSubset::kAll ? row.summary.n : 0;
+  CHECK(total == expected);
+}
+
+TEST_CASE("3D views: selected examples decode to the subsampled clouds and posed models") {
+  Fixture f;
+  const EvaluationRow& row = *f.evaluation.MainRow();
+  const double threshold = f.evaluation.options.adds_threshold;
+  const std::vector<ReportView> views = SelectReportViews(f.object, f.dataset, row, threshold, {2, 3, 250});
+  int certified = 0, rejected = 0, available_certified = 0, available_rejected = 0;
+  for (const auto& s : row.samples) {
+    if (!s.ok()) continue;
+    (s.certified() ? available_certified : available_rejected) += 1;
+  }
+  for (const auto& v : views) (v.certified ? certified : rejected) += 1;
+  CHECK(certified == std::min(2, available_certified));
+  CHECK(rejected == std::min(3, available_rejected));
+  REQUIRE(!views.empty());
+  for (const auto& v : views) {
+    CHECK(v.input.cols() <= 250);
+    CHECK(v.posed_model.cols() <= 250);
+    CHECK(v.keypoints.cols() == f.object.num_keypoints());
+  }
+  ReportInput input;
+  input.evaluation = &f.evaluation;
+  input.views = views;
+  const std::string html = ReportHtml(input);
+  const nlohmann::json data = nlohmann::json::parse(ScriptBody(html, "c3po-views"));
+  REQUIRE(data["views"].size() == views.size());
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const auto& v = data["views"][k];
+    CHECK(v["certified"].get<bool>() == views[k].certified);
+    CHECK(Base64Floats(v["input"]) == 3 * static_cast<std::size_t>(views[k].input.cols()));
+    CHECK(Base64Floats(v["posed_model"]) == 3 * static_cast<std::size_t>(views[k].posed_model.cols()));
+    CHECK(Base64Floats(v["keypoints"]) == 3 * static_cast<std::size_t>(f.object.num_keypoints()));
+  }
+  // A cloud name that tries to close the script element cannot.
+  input.views[0].cloud = "evil</script><b>.ply";
+  CHECK(CheckHtml(ReportHtml(input)) == "");
+  // Without views no three.js is embedded.
+  input.views.clear();
+  const std::string plain = ReportHtml(input);
+  CHECK(ScriptBody(plain, "c3po-three").empty());
+  CHECK(CheckHtml(plain) == "");
+}
+
+TEST_CASE("training logs are read (numeric fields) and plotted; malformed lines are input errors") {
+  TempDir dir("report_test_logs");
+  {
+    std::ofstream log(dir / "sim.model.log.jsonl");
+    for (int e = 1; e <= 5; ++e) {
+      log << "{\"epoch\": " << e << ", \"train_loss\": " << 1.0 / e << ", \"val_loss\": " << 1.5 / e
+          << ", \"oc_val\": " << 0.2 * e << ", \"note\": \"text\"}\n";
+    }
+    log << "\n";
+  }
+  const TrainingLog log = ReadTrainingLog(dir / "sim.model.log.jsonl", "sim");
+  REQUIRE(log.epochs.size() == 5);
+  CHECK(log.epochs[2].at("train_loss") == doctest::Approx(1.0 / 3));
+  CHECK(log.epochs[4].at("oc_val") == doctest::Approx(1.0));
+  CHECK(log.epochs[0].count("note") == 0);
+
+  {
+    std::ofstream bad(dir / "bad.jsonl");
+    bad << "{\"epoch\": 1}\n{\"epoch\": 2}\n[1, 2]\n";
+  }
+  try {
+    ReadTrainingLog(dir / "bad.jsonl", "bad");
+    FAIL("expected an InputError");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()).find("bad.jsonl: line 3") != std::string::npos);
+  }
+  CHECK_THROWS_AS(ReadTrainingLog(dir / "missing.jsonl", "x"), InputError);
+
+  const ObjectModel object = EvaluationObject();
+  Evaluation evaluation;
+  evaluation.object_name = "asym";
+  evaluation.diameter = object.diameter();
+  evaluation.options = EvaluationOptions::Defaults(object);
+  ReportInput input;
+  input.evaluation = &evaluation;
+  input.training = {log};
+  const std::string html = ReportHtml(input);
+  CHECK(CheckHtml(html) == "");
+  CHECK(html.find("sim: loss per epoch") != std::string::npos);
+  CHECK(html.find("sim: certified / observably correct per epoch") != std::string::npos);
+  // oc_val is a fraction: plotted as percent, 5 points (one marker per epoch).
+  const std::string percent_chart = html.substr(html.find("sim: certified / observably correct per epoch"));
+  const std::size_t polyline = percent_chart.find("<polyline");
+  const std::string points = percent_chart.substr(polyline, percent_chart.find("\">", polyline) - polyline);
+  CHECK(std::count(points.begin(), points.end(), ',') == 5);
+}
+
+TEST_CASE("the report is written atomically") {
+  TempDir dir("report_test_atomic");
+  const ObjectModel object = EvaluationObject();
+  Evaluation evaluation;
+  evaluation.object_name = "asym";
+  evaluation.diameter = object.diameter();
+  evaluation.options = EvaluationOptions::Defaults(object);
+  ReportInput input;
+  input.evaluation = &evaluation;
+
+  const std::string path = dir / "report.html";
+  WriteFileAtomically(path, "old report\n");
+  ReportInput broken;   // no evaluation: fails before anything is written
+  CHECK_THROWS(WriteReport(path, broken));
+  CHECK(ReadFileToString(path) == "old report\n");
+
+  WriteReport(path, input);
+  CHECK(ReadFileToString(path) == ReportHtml(input));
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir.path())) files.push_back(entry.path().filename().string());
+  CHECK(files == std::vector<std::string>{"report.html"});   // no temporary left behind
+
+  CHECK_THROWS_AS(WriteReport(dir / "no/such/folder/report.html", input), InputError);
+}
