@@ -4,12 +4,12 @@
 #include <stdexcept>
 
 #include "c3po/random.hpp"
+#include "head_layer.hpp"
 #include "point_layers.hpp"
 
 namespace c3po::pointnet {
 namespace {
 
-using tiny_dnn::fully_connected_layer;
 namespace activation = tiny_dnn::activation;
 
 // Uniform(-limit, limit) for every entry.
@@ -37,15 +37,17 @@ void PointNetwork::Build() {
   layer_names_.push_back("point_mlp");
   int channels = widths.back();
   for (std::size_t h = 0; h < shape_.head.size(); ++h) {
-    net_ << fully_connected_layer<activation::relu>(static_cast<tiny_dnn::serial_size_t>(channels),
-                                                   static_cast<tiny_dnn::serial_size_t>(shape_.head[h]));
+    net_ << HeadLayer<activation::relu>(channels, shape_.head[h]);
     layer_names_.push_back("head." + std::to_string(h));
     channels = shape_.head[h];
   }
-  net_ << fully_connected_layer<activation::identity>(
-      static_cast<tiny_dnn::serial_size_t>(channels),
-      static_cast<tiny_dnn::serial_size_t>(shape_.outputs));
+  net_ << HeadLayer<activation::identity>(channels, shape_.outputs);
   layer_names_.push_back("output");
+  // tiny-dnn's backward kernel of a fully connected layer would start threads
+  // per sample and layer (std::async); the head is small, so it runs serially.
+  for (auto* layer : net_) {
+    if (layer->layer_type() == "fully-connected") layer->set_parallelize(false);
+  }
   net_.init_weight();   // allocates every edge; values are replaced below
 }
 
@@ -70,17 +72,7 @@ void PointNetwork::Initialise(std::uint64_t seed) {
   }
 }
 
-// tiny-dnn's fully connected kernels split the forward pass over samples (one
-// std::async per thread) but the backward pass over the outputs of each sample
-// (threads started per sample and layer): parallel forward, serial backward.
-void PointNetwork::SetHeadParallel(bool parallel) {
-  for (auto* layer : net_) {
-    if (layer->layer_type() == "fully-connected") layer->set_parallelize(parallel);
-  }
-}
-
 tiny_dnn::tensor_t PointNetwork::Forward(const tiny_dnn::tensor_t& inputs) {
-  SetHeadParallel(threads_ != 1);
   net_[0]->set_in_data({inputs});
   for (auto* layer : net_) layer->forward();
   return net_[net_.layer_size() - 1]->output()[0];
@@ -102,7 +94,6 @@ double PointNetwork::ForwardBackward(const tiny_dnn::tensor_t& inputs,
   // tiny-dnn averages the per-sample weight gradients over the batch in
   // update_weight, so the per-sample gradient is that of the sample's loss.
   net_[net_.layer_size() - 1]->set_out_grads({output_grad});
-  SetHeadParallel(false);
   for (std::size_t i = net_.layer_size(); i-- > 0;) net_[i]->backward();
   return loss / static_cast<double>(outputs.size());
 }

@@ -2,8 +2,8 @@
 // The PointNet keypoint regressor as a tiny-dnn network:
 //   per-point MLP 3 -> m1 -> ... -> mk (ReLU) and max over points
 //   (PointEncoderLayer, a custom tiny-dnn layer, point_layers.hpp)
-//   -> fully connected head mk -> h1 -> ... (tiny-dnn fully_connected_layer, ReLU)
-//   -> 3N outputs (fully_connected_layer, identity).
+//   -> fully connected head mk -> h1 -> ... (ReLU) -> 3N outputs (identity):
+//   tiny-dnn fully_connected_layers with a batched forward pass (HeadLayer).
 // tiny-dnn carries the graph (edges, per-sample tensors), the fully connected
 // layers and the weight update (layer::update_weight with a tiny_dnn::optimizer);
 // this class drives forward / backward / update over a batch.
@@ -57,7 +57,6 @@ class PointNetwork {
 
  private:
   void Build();
-  void SetHeadParallel(bool parallel);
   void Initialise(std::uint64_t seed);
 
   NetworkShape shape_;
