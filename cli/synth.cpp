@@ -128,9 +128,18 @@ int Run(const SynthCommand& o) {
               o.output.c_str(), report.count, ToString(options.kind), object.name().c_str(),
               report.diameter, report.mean_points, report.min_cloud_points, report.max_cloud_points,
               ToString(options.pose.mode), static_cast<unsigned long long>(options.seed));
-  if (options.pose.mode != PoseMode::kPaper || options.kind == CloudKind::kDepth) {
+  if (options.pose.mode == PoseMode::kPaper) {
+    if (options.kind == CloudKind::kSim) {
+      std::printf("object centre in [0, 1]^3 m\n");
+    } else {
+      std::printf("object centre in [-0.5, 0.5]^2 x [%.4g, %.4g] m", report.distance_range.second,
+                  report.distance_range.second + 1.0);
+    }
+  } else {
     std::printf("object centre depth in [%.4g, %.4g] m", report.distance_range.first,
                 report.distance_range.second);
+  }
+  if (options.pose.mode != PoseMode::kPaper || options.kind == CloudKind::kDepth) {
     if (options.kind == CloudKind::kDepth) {
       std::printf("; %.2f views drawn per cloud; %.1f %% of keypoints visible on average",
                   report.mean_attempts, 100.0 * report.visible_keypoint_fraction);
