@@ -2,6 +2,7 @@
 // c3po/plugins/plugin_api.h.
 #include <dlfcn.h>
 
+#include <filesystem>
 #include <string>
 
 #include "c3po/error.hpp"
@@ -47,8 +48,13 @@ std::string DlError() {
 }  // namespace
 
 void LoadPlugin(const std::string& path) {
+  // dlopen searches the system library path for a name without '/': a plugin
+  // named on the command line is a file, so make it a path.
+  const std::string file = path.find('/') == std::string::npos ? "./" + path : path;
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) throw InputError(path, "no such plugin file");
   // RTLD_NODELETE keeps the code mapped for detectors that outlive this call.
-  void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
+  void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
   if (!handle) throw InputError(path, "cannot load plugin: " + DlError());
   auto entry = reinterpret_cast<c3po_detector_plugin_entry>(dlsym(handle, "c3po_detector_plugin_v1"));
   if (!entry) throw InputError(path, "not a c3po plugin: no symbol c3po_detector_plugin_v1");

@@ -2,6 +2,7 @@
 // the test plugins built in tests/targets/test_plugin/.
 #include <doctest/doctest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -125,6 +126,22 @@ TEST_CASE("LoadPlugin loads the centroid test plugin and its detector works") {
   CHECK(detector->Detect(clouds[0]) == batch[0]);
 }
 
+TEST_CASE("LoadPlugin takes a bare file name as a file in the working directory") {
+  const std::filesystem::path plugin(C3PO_TEST_PLUGIN);
+  const std::filesystem::path previous = std::filesystem::current_path();
+  std::filesystem::current_path(plugin.parent_path());
+  std::string message = "not thrown";
+  try {
+    LoadPlugin(plugin.filename().string());   // not searched on the library path
+    message.clear();
+  } catch (const InputError& error) {
+    message = error.what();
+  }
+  std::filesystem::current_path(previous);
+  CHECK(message.empty());
+  CHECK(FindInfo(ListDetectors(), "centroid") != nullptr);
+}
+
 TEST_CASE("LoadPlugin rejects what is not a c3po plugin, naming the file") {
   SUBCASE("a library without the entry point") {
     const std::string message = InputErrorMessage([] { LoadPlugin(C3PO_TEST_NOT_A_PLUGIN); });
@@ -132,9 +149,15 @@ TEST_CASE("LoadPlugin rejects what is not a c3po plugin, naming the file") {
     CHECK(Contains(message, "c3po_detector_plugin_v1"));
   }
   SUBCASE("a missing file") {
-    const std::string path = "/nonexistent/libnothing_here.so";
-    const std::string message = InputErrorMessage([&] { LoadPlugin(path); });
-    CHECK(Contains(message, path));
+    for (const std::string path : {"/nonexistent/libnothing_here.so", "libnothing_here.so"}) {
+      const std::string message = InputErrorMessage([&] { LoadPlugin(path); });
+      CHECK(Contains(message, path));
+      CHECK(Contains(message, "no such"));
+    }
+  }
+  SUBCASE("a folder") {
+    const std::string path = std::filesystem::path(C3PO_TEST_PLUGIN).parent_path().string();
+    CHECK(Contains(InputErrorMessage([&] { LoadPlugin(path); }), path));
   }
   SUBCASE("a text file") {
     test::TempDir dir("plugin_test_text");
