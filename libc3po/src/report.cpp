@@ -233,8 +233,14 @@ std::string AddsPlotsHtml(const Evaluation& e) {
 bool IsLossField(const std::string& name) {
   return name.find("loss") != std::string::npos || name.find("error") != std::string::npos;
 }
+bool EndsWith(const std::string& name, const std::string& suffix) {
+  return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+// "validation_percent_oc", "oc_val", "train_oc", "validation_percent_certified"
+// (not "certified_samples", a count).
 bool IsPercentField(const std::string& name) {
-  return name.rfind("oc", 0) == 0 || name.rfind("nd", 0) == 0 || name.find("certified") != std::string::npos;
+  return name.find("percent") != std::string::npos || name.rfind("oc", 0) == 0 || name.rfind("nd", 0) == 0 ||
+         EndsWith(name, "_oc") || EndsWith(name, "_nd") || EndsWith(name, "certified");
 }
 
 // One chart of the fields selected by `select`; percentages scaled to 0..100
@@ -258,7 +264,7 @@ std::string TrainingChart(const TrainingLog& log, bool percent) {
     series.name = fields[f];
     series.colour = Colour(f);
     series.markers = log.epochs.size() <= 60;
-    bool fractions = true;
+    bool fractions = fields[f].find("percent") == std::string::npos;
     for (const auto& epoch : log.epochs) {
       auto it = epoch.find(fields[f]);
       if (it != epoch.end() && std::isfinite(it->second) && std::abs(it->second) > 1.0) fractions = false;

@@ -271,3 +271,39 @@ TEST_CASE("the report is written atomically") {
 
   CHECK_THROWS_AS(WriteReport(dir / "no/such/folder/report.html", input), InputError);
 }
+
+TEST_CASE("selftrain-style logs: percent fields are not rescaled and counts are not plotted as percentages") {
+  TempDir dir("report_test_selftrain_log");
+  {
+    std::ofstream log(dir / "self.model.log.jsonl");
+    log << "{\"phase\": \"selftrain\", \"epoch\": 1, \"train_percent_oc\": 0.5, \"validation_percent_certified\": 0.25, "
+           "\"loss\": 0.3, \"certified_samples\": 7, \"best\": true}\n";
+    log << "{\"phase\": \"selftrain\", \"epoch\": 2, \"train_percent_oc\": 0.75, \"validation_percent_certified\": 1.0, "
+           "\"loss\": 0.2, \"certified_samples\": 9, \"best\": false}\n";
+  }
+  const TrainingLog log = ReadTrainingLog(dir / "self.model.log.jsonl", "self");
+  REQUIRE(log.epochs.size() == 2);
+  CHECK(log.epochs[0].count("best") == 0);   // booleans are not numbers
+  const ObjectModel object = EvaluationObject();
+  Evaluation evaluation;
+  evaluation.object_name = "asym";
+  evaluation.diameter = object.diameter();
+  evaluation.options = EvaluationOptions::Defaults(object);
+  ReportInput input;
+  input.evaluation = &evaluation;
+  input.training = {log};
+  const std::string html = ReportHtml(input);
+  const std::size_t start = html.find("self: certified / observably correct per epoch");
+  REQUIRE(start != std::string::npos);
+  const std::string chart = html.substr(start, html.find("</svg>", start) - start);
+  CHECK(chart.find(">train_percent_oc<") != std::string::npos);
+  CHECK(chart.find(">validation_percent_certified<") != std::string::npos);
+  CHECK(chart.find("certified_samples") == std::string::npos);
+  // The percent axis runs 0..100 and the values stay as given (0.5 %, not 50 %): the
+  // curve of train_percent_oc hugs the bottom of the plot area.
+  const std::size_t polyline = chart.find("<polyline");
+  const std::string points = chart.substr(polyline, chart.find("\">", polyline) - polyline);
+  const std::size_t comma = points.find(',');
+  const double y = std::stod(points.substr(comma + 1));
+  CHECK(y > 240.0);   // plot area bottom = height 300 - 40 = 260; 0.5 % of 232 px above it
+}

@@ -28,8 +28,10 @@ namespace c3po {
 
 // One training log: JSON lines, one object per epoch with numeric fields
 // (e.g. epoch, train_loss, val_loss, val_keypoint_error, oc_train, oc_val).
-// Fields named *loss* or *error* are plotted as losses; fields named oc*,
-// nd* or *certified* as percentages (fractions in [0, 1] are scaled by 100).
+// Fields named *loss* or *error* are plotted as losses; fields named
+// *percent*, oc*, nd*, *_oc, *_nd or *certified as percentages (without
+// "percent" in the name and every value in [0, 1]: fractions, scaled by 100).
+// The logs of `c3po train` / `c3po selftrain` (MODEL.log.jsonl) qualify.
 struct TrainingLog {
   std::string label;
   std::string path;
