@@ -3,6 +3,8 @@
 // checkpoints) and the model file (round trip, wrong object, corrupt files).
 #include <doctest/doctest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -361,6 +363,20 @@ TEST_CASE("pointnet model files: round trip, wrong object, truncated and corrupt
   std::string bad_header = bytes;
   bad_header[header_end / 3] = '}';
   WriteBytes(broken, bad_header);
+  CHECK_THROWS_AS(PointNetDetector::Load(broken, Identity("box", 3)), c3po::InputError);
+  // A header edited to claim a huge network (the weights' checksum still
+  // holds) is refused before anything is allocated.
+  nlohmann::json header = nlohmann::json::parse(bytes.substr(0, header_end));
+  header["point_mlp"] = {8192, 8192, 8192};
+  WriteBytes(broken, header.dump() + bytes.substr(header_end));
+  CHECK_THROWS_AS(PointNetDetector::Load(broken, Identity("box", 3)), c3po::InputError);
+  header = nlohmann::json::parse(bytes.substr(0, header_end));
+  header["num_points"] = -5;
+  WriteBytes(broken, header.dump() + bytes.substr(header_end));
+  CHECK_THROWS_AS(PointNetDetector::Load(broken, Identity("box", 3)), c3po::InputError);
+  header = nlohmann::json::parse(bytes.substr(0, header_end));
+  header["scale"] = "big";
+  WriteBytes(broken, header.dump() + bytes.substr(header_end));
   CHECK_THROWS_AS(PointNetDetector::Load(broken, Identity("box", 3)), c3po::InputError);
   WriteBytes(broken, std::string(5000, '\xff'));
   CHECK_THROWS_AS(PointNetDetector::Load(broken, Identity("box", 3)), c3po::InputError);

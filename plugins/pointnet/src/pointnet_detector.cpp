@@ -25,15 +25,18 @@ void CheckWidths(const std::vector<int>& widths, const char* what, bool allow_em
 }  // namespace
 
 void PointNetArchitecture::Check() const {
-  if (num_points < 1 || num_points > 1 << 20) {
-    throw std::invalid_argument("num_points must be in [1, 1048576]");
+  if (num_points < 1 || num_points > 65536) {
+    throw std::invalid_argument("num_points must be in [1, 65536]");
   }
   CheckWidths(point_mlp, "point_mlp", false);
   CheckWidths(head, "head", true);
+  if (point_mlp.size() + head.size() > 32) throw std::invalid_argument("more than 32 layers");
 }
 
 void PointNetIdentity::Check() const {
-  if (num_keypoints < 1) throw std::invalid_argument("the object has no keypoints");
+  if (num_keypoints < 1 || num_keypoints > 100000) {
+    throw std::invalid_argument("the number of keypoints must be in [1, 100000]");
+  }
   if (!(std::isfinite(scale) && scale > 0.0)) throw std::invalid_argument("scale must be finite and > 0");
 }
 

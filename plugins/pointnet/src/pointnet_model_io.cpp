@@ -57,6 +57,17 @@ std::vector<int> Widths(const json& header, const char* key, const std::string& 
   return widths;
 }
 
+// Weights + biases of the point MLP (from 3 channels) and the head (to 3N).
+std::size_t ParameterCount(const PointNetArchitecture& architecture, int num_keypoints) {
+  std::vector<std::size_t> widths = {3};
+  for (int w : architecture.point_mlp) widths.push_back(static_cast<std::size_t>(w));
+  for (int w : architecture.head) widths.push_back(static_cast<std::size_t>(w));
+  widths.push_back(3 * static_cast<std::size_t>(num_keypoints));
+  std::size_t count = 0;
+  for (std::size_t l = 0; l + 1 < widths.size(); ++l) count += widths[l + 1] * (widths[l] + 1);
+  return count;
+}
+
 void CheckFinite(const std::vector<float>& values, const std::string& path, const char* what) {
   for (float v : values) {
     if (!std::isfinite(v)) throw InputError(path, std::string("corrupt model: non-finite ") + what);
@@ -197,20 +208,24 @@ std::unique_ptr<PointNetDetector::Impl> LoadImpl(const std::string& path,
   architecture.head = Widths(h, "head", path);
   const std::string kind = Field(h, "kind", json::value_t::string, path).get<std::string>();
   if (checkpoint && kind != "checkpoint") throw InputError(path, "is a model, not a training checkpoint");
-  std::unique_ptr<PointNetDetector::Impl> impl;
   try {
     identity.Check();
     architecture.Check();
-    impl = std::make_unique<PointNetDetector::Impl>(identity, architecture, 0);
   } catch (const std::invalid_argument& e) {
     throw InputError(path, std::string("invalid model header: ") + e.what());
   }
+  // Sizes are checked against the file before any network is allocated.
   const json& weights = Field(h, "weights", json::value_t::object, path);
-  const std::size_t expected_count = impl->network->Weights().size();
+  const std::size_t expected_count = ParameterCount(architecture, identity.num_keypoints);
   if (!weights.contains("count") || !weights["count"].is_number_unsigned() ||
-      weights["count"].get<std::size_t>() != expected_count) {
+      weights["count"].get<std::size_t>() != expected_count ||
+      expected_count > file.binary.size() / sizeof(float)) {
     throw InputError(path, "corrupt model: weight count does not match the architecture (" +
                                std::to_string(expected_count) + ")");
+  }
+  auto impl = std::make_unique<PointNetDetector::Impl>(identity, architecture, 0);
+  if (impl->network->Weights().size() != expected_count) {
+    throw std::logic_error("pointnet: parameter count formula disagrees with the network");
   }
   pointnet::BinaryReader reader(file.binary, path);
   const std::vector<float> values = reader.Floats(expected_count, "weights");
