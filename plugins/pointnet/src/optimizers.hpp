@@ -19,6 +19,8 @@
 
 namespace c3po::pointnet {
 
+// update() may run concurrently for different weight vectors (the state map is
+// only read after construction).
 class StatefulOptimizer : public tiny_dnn::optimizer {
  public:
   // `order` fixes the order in which per-vector state is saved.

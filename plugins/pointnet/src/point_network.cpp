@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "c3po/parallel.hpp"
 #include "c3po/random.hpp"
 #include "head_layer.hpp"
 #include "point_layers.hpp"
@@ -98,10 +99,13 @@ double PointNetwork::ForwardBackward(const tiny_dnn::tensor_t& inputs,
   return loss / static_cast<double>(outputs.size());
 }
 
+// Layers update independently (each its own weights, gradients and optimiser
+// slots), so they are spread over the threads; the result does not depend on
+// the schedule.
 void PointNetwork::Update(tiny_dnn::optimizer* optimizer, int batch_size) {
-  for (auto* layer : net_) {
-    layer->update_weight(optimizer, static_cast<tiny_dnn::serial_size_t>(batch_size));
-  }
+  ParallelFor(0, static_cast<int>(net_.layer_size()), [&](int i) {
+    net_[static_cast<std::size_t>(i)]->update_weight(optimizer, static_cast<tiny_dnn::serial_size_t>(batch_size));
+  }, threads_);
 }
 
 std::vector<double> PointNetwork::TakeGradient(int batch_size) {
