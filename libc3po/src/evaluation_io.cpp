@@ -89,6 +89,21 @@ std::string SoundnessLines(const Evaluation& e) {
   return out.str();
 }
 
+// Rows with samples that have no pose (unreadable cloud, detector failure,
+// degenerate keypoints): how many, and the first reason.
+std::string FailureLines(const Evaluation& e) {
+  std::ostringstream out;
+  for (const auto& row : e.rows) {
+    if (row.subset != EvalSubset::kAll || row.summary.failures == 0) continue;
+    const auto first = std::find_if(row.samples.begin(), row.samples.end(),
+                                    [](const SampleResult& s) { return !s.ok(); });
+    out << "Failures: " << row.label << ": " << row.summary.failures << " of " << row.summary.n
+        << " samples without a pose (counted as ADD-S = inf, not certified); first: " << first->cloud << ": "
+        << first->error << "\n";
+  }
+  return out.str();
+}
+
 json SampleJson(const SampleResult& s) {
   json j;
   j["cloud"] = s.cloud;
@@ -159,7 +174,7 @@ std::string EvaluationTable(const Evaluation& e) {
       out << std::string(total - 2, '-') << "\n";
     }
   }
-  out << SettingsLines(e) << SoundnessLines(e);
+  out << SettingsLines(e) << FailureLines(e) << SoundnessLines(e);
   return out.str();
 }
 

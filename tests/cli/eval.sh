@@ -85,6 +85,13 @@ grep -q "eps_oc = 0.01 " table2.txt || fail "eps_oc not stated"
 grep -q "delta_nd = 0.008 " table2.txt || fail "delta_nd not stated"
 grep -q '"adds_threshold": 0.02' stdout.json || fail "--json - did not print the JSON on stdout"
 
+# A corrupt cloud is a per-sample failure, reported, not a crash.
+mkdir -p corrupt && cp data/* corrupt/
+head -c 200 data/000003.ply > corrupt/000003.ply
+"$C3PO" eval "$OBJECT" --data corrupt --detector manifest --no-icp > corrupt.txt 2>&1 || { cat corrupt.txt; fail "eval on a corrupt cloud"; }
+grep -q "Failures: KeyPo (manifest): 1 of 10 samples without a pose.*000003.ply" corrupt.txt \
+  || { cat corrupt.txt; fail "corrupt cloud not reported"; }
+
 # ---- bad inputs: exit 2, one line naming the problem, outputs untouched ----
 cp report.html report.before
 expect_error() {   # expect_error PATTERN ARGS...

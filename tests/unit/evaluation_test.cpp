@@ -180,6 +180,7 @@ TEST_CASE("KeyPo, ICP and corrector rows match brute-force ADD-S, certificates a
   CHECK(keypo.summary.failures == 3);
   CHECK(keypo.summary.percent_certified == doctest::Approx(100.0 * 4 / kClouds));
   CHECK(e.total_false_certificates() == 0);
+  CHECK(EvaluationTable(e).find("Failures: KeyPo (manifest): 3 of 12 samples without a pose") != std::string::npos);
 }
 
 TEST_CASE("self-trained detectors give the C-3PO rows on the certified subsets") {
