@@ -22,15 +22,17 @@
 //
 // Model file (Save / Load): one line of JSON, then a binary block:
 //   {"magic":"c3po-model","format_version":1,"detector":"pointnet",
-//    "object":NAME,"keypoint_hash":HASH,"num_keypoints":N,"num_points":n,
-//    "scale":s,"point_mlp":[...],"head":[...],"kind":"model"|"checkpoint",
-//    "weights":{"count":W,"fnv1a64":"..."},"training":{...},
-//    "optimizer":{...} (checkpoints only)}\n
-//   W little-endian float32 weights (order: PointNetDetector::WeightBlocks()),
-//   then, for a checkpoint, the optimiser state and the best weights so far.
-// Loading checks every field, the sizes and the checksum, and that the file was
-// trained for the given object (name and keypoint hash): anything else is a
-// c3po::InputError naming the file.
+//    "kind":"model"|"checkpoint","object":NAME,"keypoint_hash":HASH,
+//    "num_keypoints":N,"num_points":n,"scale":s,"point_mlp":[...],"head":[...],
+//    "weights":{"count":W,"dtype":"float32-le"},"training":{...},
+//    "binary":{"bytes":B,"fnv1a64":"<hex>"}, ...header extras}\n
+//   then W float32 weights (order: WeightBlocks()). A checkpoint adds
+//   "optimizer":{kind, lr, momentum, state_bytes}, "progress":{epochs_done,
+//   best_epoch, best_val_loss, best_weights, history}, "state":"<caller's
+//   JSON>" and, after the weights, the optimiser state and the best weights.
+// Loading checks every field, the sizes (before allocating anything) and the
+// checksum, and that the file was trained for the given object (name and
+// keypoint hash): anything else is a c3po::InputError naming the file.
 #include <cstdint>
 #include <functional>
 #include <memory>
