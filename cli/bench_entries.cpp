@@ -3,6 +3,9 @@
 
 namespace c3po::cli {
 
-std::vector<BenchEntry> BenchEntries() { return {}; }
+void SetupSynthBench(CLI::App& parent, std::function<int()>* run);
+void SetupPointNetBench(CLI::App& parent, std::function<int()>* run);
+
+std::vector<BenchEntry> BenchEntries() { return {{SetupSynthBench}, {SetupPointNetBench}}; }
 
 }  // namespace c3po::cli

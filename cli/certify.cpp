@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "c3po/atomic_file.hpp"
+#include "c3po/auto_threshold.hpp"
 #include "c3po/cloud_io.hpp"
 #include "c3po/dataset.hpp"
 #include "c3po/error.hpp"
@@ -129,6 +130,27 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
   return text;
 }
 
+// --eps-oc auto: estimate eps_oc from the clouds being certified and the oc
+// distances just computed (they do not depend on eps_oc), then decide oc again.
+double DecideAutoEpsOc(const ObjectModel& object, const std::vector<PointSet>& clouds,
+                       std::vector<CloudOutcome>* outcomes) {
+  std::vector<PointSet> usable;
+  std::vector<double> oc_distances;
+  for (std::size_t i = 0; i < outcomes->size(); ++i) {
+    const CloudOutcome& outcome = (*outcomes)[i];
+    if (!outcome.error.empty()) continue;
+    usable.push_back(clouds[i]);
+    if (outcome.estimate.ok()) oc_distances.push_back(outcome.estimate.certificate.oc.max_point_distance);
+  }
+  const AutoEpsOcResult chosen = EstimateEpsOc(object, usable, AutoEpsOcOptions{}, &oc_distances);
+  for (CloudOutcome& outcome : *outcomes) {
+    if (outcome.error.empty()) RethresholdObservableCorrectness(&outcome.estimate.certificate.oc, chosen.eps_oc);
+  }
+  std::fprintf(stderr, "c3po certify: --eps-oc auto = %.6g (%s; eps_w = %.4g, eps_s = %.4g); evidence %s\n",
+               chosen.eps_oc, chosen.rule.c_str(), chosen.noise.eps_w, chosen.sampling.eps_s, chosen.ToJson().c_str());
+  return chosen.eps_oc;
+}
+
 int Run(const CertifyCommand& cmd) {
   if (cmd.model_path.empty() == cmd.detector_name.empty()) {
     throw InputError("c3po certify", "give exactly one of --model FILE or --detector NAME");
@@ -139,12 +161,14 @@ int Run(const CertifyCommand& cmd) {
   options.corrector.solver = ParseCorrectorSolver(cmd.solver);
   options.corrector.loss = ParsePointCloudLoss(cmd.loss);
   options.certificate = CertificateOptions::FromObject(object.spec());
-  if (!cmd.eps_oc_text.empty()) options.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
+  const bool auto_eps_oc = cmd.eps_oc_text == "auto";
+  if (!cmd.eps_oc_text.empty() && !auto_eps_oc) options.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
   if (!cmd.delta_nd_text.empty()) options.certificate.delta_nd = ParseThreshold(cmd.delta_nd_text, object.diameter(), "--delta-nd");
   const std::vector<CloudJob> jobs = CollectJobs(cmd);
   const std::unique_ptr<Detector> detector = MakeDetector(cmd, object);
 
   std::vector<CloudOutcome> outcomes(jobs.size());
+  std::vector<PointSet> clouds(auto_eps_oc ? jobs.size() : 0);   // kept for --eps-oc auto
   ProgressBar progress("certify", jobs.size());
   std::atomic<std::size_t> done{0};
   ParallelFor(0, static_cast<int>(jobs.size()), [&](int i) {
@@ -158,12 +182,15 @@ int Run(const CertifyCommand& cmd) {
                                        std::to_string(object.num_keypoints()));
       }
       outcomes[i].estimate = EstimateAndCertify(object, cloud, detected, options);
+      if (auto_eps_oc) clouds[i] = cloud;
     } catch (const InputError& e) {
       outcomes[i].error = e.what();
     }
     progress.Update(++done);
   });
   progress.Finish();
+
+  if (auto_eps_oc) options.certificate.eps_oc = DecideAutoEpsOc(object, clouds, &outcomes);
 
   std::ostringstream json_lines;
   int certified = 0, oc = 0, nd = 0, errors = 0;
@@ -208,7 +235,7 @@ RunFunction SetupCertify(CLI::App& command) {
   command.add_option("--plugin", cmd->plugins, "Load a detector plugin (shared library); repeatable");
   command.add_flag("--json", cmd->json, "One JSON object per cloud on stdout");
   command.add_option("-o,--output", cmd->output_path, "Write the JSON lines to this file (atomically)");
-  command.add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold: distance or fraction of d (3%d)");
+  command.add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold: distance, fraction of d (3%d) or auto (estimated from the clouds)");
   command.add_option("--delta-nd", cmd->delta_nd_text, "Non-degeneracy threshold: distance or fraction of d");
   command.add_flag("--no-correct", cmd->no_correct, "Certify the plain registration of the detected keypoints");
   command.add_option("--solver", cmd->solver, "Corrector solver: fast (default) or gd (the reference's)");

@@ -1,8 +1,135 @@
-// c3po selftrain
+// c3po selftrain: certificate-gated self-training of a trained detector on
+// unlabelled clouds (paper Section VI-C): only observably correct outputs
+// teach the detector, with their corrected keypoints as targets.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "c3po/dataset.hpp"
+#include "c3po/error.hpp"
+#include "c3po/object_io.hpp"
+#include "c3po/plugins/pointnet.hpp"
+#include "c3po/selftrain.hpp"
 #include "command.hpp"
+#include "common.hpp"
+#include "training_common.hpp"
 
 namespace c3po::cli {
+namespace {
 
-RunFunction SetupSelftrain(CLI::App& command) { return NotBuiltYet(command, "Detector plugins and training"); }
+struct SelftrainCommand {
+  std::string object_path;
+  std::string model_path;
+  std::string data_dir;
+  std::string output_path;
+  SelfTrainOptions options;
+  double lr = 1e-3;
+  std::string optimizer = "adam";
+  std::string eps_oc_text;
+  std::string delta_nd_text;
+  std::string solver = "fast";
+  bool resume = false;
+};
+
+nlohmann::json EpochJson(const SelfTrainEpochLog& e) {
+  return {{"phase", "selftrain"}, {"epoch", e.epoch}, {"train_percent_oc", e.train_percent_oc},
+          {"validation_percent_oc", e.validation_percent_oc},
+          {"validation_percent_certified", e.validation_percent_certified},
+          {"validation_detection_error", e.validation_detection_error}, {"loss", e.loss},
+          {"mean_corrector_iterations", e.mean_corrector_iterations},
+          {"certified_samples", e.certified_samples}, {"seconds", e.seconds}};
+}
+
+int Run(SelftrainCommand cmd) {
+  const ObjectModel object = LoadObject(cmd.object_path);
+  std::unique_ptr<PointNetDetector> detector = PointNetDetector::Load(cmd.model_path, object);
+  PointNetTrainOptions train_options = detector->train_options();
+  train_options.lr = cmd.lr;
+  train_options.optimizer = cmd.optimizer;
+  train_options.num_points = detector->architecture().num_points;
+  try {
+    detector->SetTrainOptions(train_options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("c3po selftrain", e.what());
+  }
+  SelfTrainOptions& options = cmd.options;
+  options.pipeline.corrector.solver = ParseCorrectorSolver(cmd.solver);
+  options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
+  if (!cmd.eps_oc_text.empty()) options.pipeline.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
+  if (!cmd.delta_nd_text.empty()) options.pipeline.certificate.delta_nd = ParseThreshold(cmd.delta_nd_text, object.diameter(), "--delta-nd");
+  options.checkpoint_path = cmd.output_path + ".ckpt";
+  try {
+    options.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("c3po selftrain", e.what());
+  }
+  if (cmd.resume && !std::filesystem::exists(options.checkpoint_path)) {
+    throw InputError(options.checkpoint_path, "no checkpoint to resume from");
+  }
+  const Dataset dataset = ReadDataset(cmd.data_dir);
+  if (dataset.entries.size() < 2) throw InputError(cmd.data_dir, "need at least 2 clouds to self-train");
+  const std::vector<PointSet> clouds = LoadDatasetClouds(dataset, "loading");
+
+  EpochLogFile log(cmd.output_path);
+  if (cmd.resume) log.LoadExisting();
+  std::fprintf(stderr, "self-training on %zu unlabelled clouds of %s: eps_oc = %.6g, delta_nd = %.6g (d = %.6g), "
+               "%d epochs, batch %d, %s lr %g\n",
+               clouds.size(), object.name().c_str(), options.pipeline.certificate.eps_oc,
+               options.pipeline.certificate.delta_nd, object.diameter(), options.epochs, options.batch,
+               cmd.optimizer.c_str(), cmd.lr);
+  ProgressBar progress("selftrain", 1);
+  const SelfTrainResult result = SelfTrain(
+      object, clouds, *detector, options,
+      [&](const SelfTrainEpochLog& e) {
+        progress.Finish();
+        log.Record(e.epoch, EpochJson(e).dump());
+        std::fprintf(stderr, "epoch %3d  train oc %5.1f%%  val oc %5.1f%%  val certified %5.1f%%  loss %.3e  "
+                     "corrector it %.1f  %.1fs\n",
+                     e.epoch, e.train_percent_oc, e.validation_percent_oc, e.validation_percent_certified, e.loss,
+                     e.mean_corrector_iterations, e.seconds);
+        progress = ProgressBar("selftrain", 1);
+      },
+      [&](std::size_t done, std::size_t total) { progress.Update(total ? done / total : 0); }, cmd.resume);
+  progress.Finish();
+  const nlohmann::json extra = {
+      {"selftrained", true},
+      {"selftrain", {{"source_model", std::filesystem::path(cmd.model_path).filename().string()},
+                     {"eps_oc", options.pipeline.certificate.eps_oc},
+                     {"delta_nd", options.pipeline.certificate.delta_nd},
+                     {"best_epoch", result.best_epoch},
+                     {"initial_validation_percent_oc", result.initial_validation_percent_oc},
+                     {"best_validation_percent_oc", result.best_validation_percent_oc},
+                     {"stopped_early", result.stopped_early}}}};
+  detector->Save(cmd.output_path, extra.dump());
+  std::printf("wrote %s: validation %% oc %.1f -> %.1f (best epoch %d%s); eps_oc = %.6g; log %s\n",
+              cmd.output_path.c_str(), result.initial_validation_percent_oc, result.best_validation_percent_oc,
+              result.best_epoch, result.stopped_early ? ", stopped early" : "",
+              options.pipeline.certificate.eps_oc, log.path().c_str());
+  return 0;
+}
+
+}  // namespace
+
+RunFunction SetupSelftrain(CLI::App& command) {
+  auto cmd = std::make_shared<SelftrainCommand>();
+  SelfTrainOptions& o = cmd->options;
+  command.add_option("object", cmd->object_path, "Object JSON")->required();
+  command.add_option("--model", cmd->model_path, "Trained model (e.g. from c3po train on sim data)")->required();
+  command.add_option("--data", cmd->data_dir, "Unlabelled dataset (ground truth, if any, is ignored)")->required();
+  command.add_option("-o,--output", cmd->output_path, "Self-trained model file to write")->required();
+  command.add_option("--epochs", o.epochs, "Maximum epochs");
+  command.add_option("--batch", o.batch, "Batch size");
+  command.add_option("--lr", cmd->lr, "Learning rate");
+  command.add_option("--optimizer", cmd->optimizer, "adam or sgd");
+  command.add_option("--val-fraction", o.validation_fraction, "Held-out fraction of the unlabelled clouds");
+  command.add_option("--stop-at", o.stop_at_percent_oc, "Stop when this % of the held-out clouds is observably correct");
+  command.add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold: distance or fraction of d (3%d)");
+  command.add_option("--delta-nd", cmd->delta_nd_text, "Non-degeneracy threshold");
+  command.add_option("--solver", cmd->solver, "Corrector solver: fast or gd");
+  command.add_option("--seed", o.seed, "Seed (split, shuffling)");
+  command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt");
+  return [cmd]() { return Run(*cmd); };
+}
 
 }  // namespace c3po::cli

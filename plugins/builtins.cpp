@@ -4,6 +4,9 @@
 #ifdef C3PO_HAVE_SVD
 #include "c3po/plugins/svd_detector.hpp"
 #endif
+#ifdef C3PO_HAVE_POINTNET
+#include "c3po/plugins/pointnet.hpp"
+#endif
 
 namespace c3po {
 
@@ -13,6 +16,12 @@ void RegisterBuiltinDetectors() {
                    [](const ObjectModel& object) -> std::unique_ptr<Detector> {
                      return std::make_unique<SvdDetector>(object);
                    });
+#endif
+#ifdef C3PO_HAVE_POINTNET
+  RegisterModelLoader({"pointnet", "PointNet keypoint regressor (tiny-dnn); train with c3po train", true},
+                      [](const std::string& path, const ObjectModel& object) -> std::unique_ptr<Detector> {
+                        return PointNetDetector::Load(path, object);
+                      });
 #endif
 }
 

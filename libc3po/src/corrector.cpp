@@ -112,6 +112,59 @@ StageResult RunStage(const ObjectModel& object, const PointSet& points, Pose pos
   return best;
 }
 
+// Gauss-Newton on the point-to-plane residuals r_j = m_j·(x_j - s_j), with
+// s_j = R p_j + t the nearest posed sample point and m_j = R n_j its normal.
+// For the update R <- Exp(ω) R, t <- Exp(ω) t + v the Jacobian of r_j is
+// [ (m_j × x_j)^T, -m_j^T ] (the normal moves with the model). Converges in a
+// few steps near the optimum; the point-to-point stage then polishes.
+StageResult RunPointToPlaneStage(const ObjectModel& object, const PointSet& points, Pose pose,
+                                 int max_iterations, double tolerance) {
+  StageResult best{pose, std::numeric_limits<double>::infinity()};
+  double previous = std::numeric_limits<double>::infinity();
+  Eigen::VectorXi nearest;
+  Eigen::VectorXd squared;
+  // One nearest-neighbour query per step: it gives both the loss at the
+  // current pose and the linearisation for the next step.
+  for (int iteration = 0; iteration <= max_iterations; ++iteration) {
+    object.NearestInPosedModel(points, pose, &nearest, &squared);
+    const double loss = squared.mean();
+    if (loss < best.loss) {
+      best.loss = loss;
+      best.pose = pose;
+    }
+    if (std::isfinite(previous) && std::abs(previous - loss) <= tolerance * std::max(previous, 1e-300)) {
+      best.converged = true;
+      break;
+    }
+    if (iteration == max_iterations) break;
+    previous = loss;
+    Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> Jtr = Eigen::Matrix<double, 6, 1>::Zero();
+    for (Eigen::Index j = 0; j < points.cols(); ++j) {
+      const Eigen::Vector3d x = points.col(j);
+      const Eigen::Vector3d m = pose.R * object.sample_normals().col(nearest(j));
+      const Eigen::Vector3d s = pose.R * object.sample().col(nearest(j)) + pose.t;
+      Eigen::Matrix<double, 6, 1> J;
+      J << m.cross(x), -m;
+      const double r = m.dot(x - s);
+      JtJ.noalias() += J * J.transpose();
+      Jtr.noalias() += J * r;
+    }
+    // Levenberg damping keeps the step bounded on near-degenerate views.
+    JtJ.diagonal().array() += 1e-6 * (JtJ.trace() / 6.0 + 1e-12);
+    const Eigen::Matrix<double, 6, 1> delta = JtJ.ldlt().solve(-Jtr);
+    if (!delta.allFinite()) break;
+    const double angle = delta.head<3>().norm();
+    const Eigen::Matrix3d step_rotation =
+        angle > 0 ? Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix()
+                  : Eigen::Matrix3d::Identity();
+    pose.R = step_rotation * pose.R;
+    pose.t = step_rotation * pose.t + delta.tail<3>();
+    ++best.iterations;
+  }
+  return best;
+}
+
 CorrectorResult SolveFast(const ObjectModel& object, const PointSet& cloud, const Pose& start,
                           const CorrectorOptions& options, CorrectorResult result) {
   Pose pose = start;
@@ -120,15 +173,18 @@ CorrectorResult SolveFast(const ObjectModel& object, const PointSet& cloud, cons
   const PointSet subset = StridedSubset(cloud, options.fast_subsample);
   const int budget = options.fast_max_iterations;
   if (options.loss == PointCloudLoss::kMeanSquared) {
-    if (subset.cols() < cloud.cols()) {
-      const StageResult coarse = RunStage(object, subset, pose, options.loss, 2.0, budget / 2, 1e-4);
-      pose = coarse.pose;
-      iterations += coarse.iterations;
-    }
-    const StageResult fine = RunStage(object, cloud, pose, options.loss, 2.0,
-                                      budget - iterations, options.fast_tolerance);
+    // Coarse: point-to-plane Gauss-Newton on a subset; fine: point-to-point
+    // majorise-minimise steps on every point (the objective itself).
+    const StageResult coarse = RunPointToPlaneStage(object, subset, pose, budget / 4, 1e-3);
+    pose = coarse.pose;
+    iterations += coarse.iterations;
+    const StageResult fine = RunPointToPlaneStage(object, cloud, pose, budget / 4, 1e-4);
     pose = fine.pose;
     iterations += fine.iterations;
+    const StageResult polish = RunStage(object, cloud, pose, options.loss, 2.0,
+                                        std::min(10, budget - iterations), options.fast_tolerance);
+    pose = polish.pose;
+    iterations += polish.iterations;
     converged = fine.converged;
   } else {
     // IRLS continuation towards the max: p = 2, 4, 8, 16, 32, then keep the

@@ -55,7 +55,16 @@ ObjectModel::ObjectModel(ObjectSpec spec, Mesh mesh, const ObjectModelOptions& o
   options.Check();
   mesh_.Validate();
   if (mesh_.empty()) throw std::invalid_argument("ObjectModel: mesh has no triangles");
-  tree_ = std::make_shared<const PointTree>(SampleSurface(mesh_, options.sample_size, options.seed));
+  SurfaceSample sample = SampleSurfaceWithTriangles(mesh_, options.sample_size, options.seed);
+  auto normals = std::make_shared<PointSet>(3, sample.points.cols());
+  for (Eigen::Index i = 0; i < sample.points.cols(); ++i) {
+    const Eigen::Vector3i tri = mesh_.triangles.col(sample.triangle(i));
+    const Eigen::Vector3d a = mesh_.vertices.col(tri(0)), b = mesh_.vertices.col(tri(1)),
+                          c = mesh_.vertices.col(tri(2));
+    normals->col(i) = (b - a).cross(c - a).normalized();
+  }
+  normals_ = std::move(normals);
+  tree_ = std::make_shared<const PointTree>(std::move(sample.points));
   diameter_ = mesh_.Diameter();
 }
 

@@ -43,7 +43,7 @@ struct CorrectorOptions {
   double gd_tolerance = 1e-12;
   // fast: stop when the relative decrease of L_pc is below fast_tolerance.
   int fast_max_iterations = 100;
-  double fast_tolerance = 1e-7;
+  double fast_tolerance = 1e-5;
   // fast: at most this many input points in the early iterations (0 = all);
   // the last iterations always use every point.
   int fast_subsample = 256;

@@ -52,6 +52,7 @@ class DatasetWriter {
   DatasetWriter& operator=(const DatasetWriter&) = delete;
 
   // Writes the cloud as binary PLY under entry.cloud and records the entry.
+  // Thread-safe: parallel producers may call Add concurrently.
   // Entries are written to the manifest in the order of their `order` keys
   // (so parallel producers can add out of order). Thread-safe. Throws
   // InputError("dir: ...") for an unsafe cloud path or a write failure.

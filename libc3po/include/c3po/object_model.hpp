@@ -52,6 +52,8 @@ class ObjectModel {
   int num_keypoints() const { return spec_.num_keypoints(); }
   const PointSet& sample() const { return tree_->points(); }   // B̂, model frame
   const PointTree& tree() const { return *tree_; }
+  // Unit outward normals of B̂ (of the triangle each sample point lies on).
+  const PointSet& sample_normals() const { return *normals_; }
   double diameter() const { return diameter_; }
   // Mean nearest-neighbour spacing of B̂ (an estimate of the sampling density
   // term eps_s of Theorem 12).
@@ -70,6 +72,7 @@ class ObjectModel {
   ObjectSpec spec_;
   Mesh mesh_;
   std::shared_ptr<const PointTree> tree_;
+  std::shared_ptr<const PointSet> normals_;
   double diameter_ = 0.0;
   mutable double spacing_ = -1.0;
 };
