@@ -133,7 +133,7 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
 // --eps-oc auto: estimate eps_oc from the clouds being certified and the oc
 // distances just computed (they do not depend on eps_oc), then decide oc again.
 double DecideAutoEpsOc(const ObjectModel& object, const std::vector<PointSet>& clouds,
-                       std::vector<CloudOutcome>* outcomes) {
+                       bool check_keypoint_agreement, std::vector<CloudOutcome>* outcomes) {
   std::vector<PointSet> usable;
   std::vector<double> oc_distances;
   for (std::size_t i = 0; i < outcomes->size(); ++i) {
@@ -144,7 +144,7 @@ double DecideAutoEpsOc(const ObjectModel& object, const std::vector<PointSet>& c
   }
   const AutoEpsOcResult chosen = EstimateEpsOc(object, usable, AutoEpsOcOptions{}, &oc_distances);
   for (CloudOutcome& outcome : *outcomes) {
-    if (outcome.error.empty()) RethresholdObservableCorrectness(&outcome.estimate.certificate.oc, chosen.eps_oc);
+    if (outcome.error.empty()) RethresholdObservableCorrectness(&outcome.estimate.certificate.oc, chosen.eps_oc, check_keypoint_agreement);
   }
   std::fprintf(stderr, "c3po certify: --eps-oc auto = %.6g (%s; eps_w = %.4g, eps_s = %.4g); evidence %s\n",
                chosen.eps_oc, chosen.rule.c_str(), chosen.noise.eps_w, chosen.sampling.eps_s, chosen.ToJson().c_str());
@@ -190,7 +190,7 @@ int Run(const CertifyCommand& cmd) {
   });
   progress.Finish();
 
-  if (auto_eps_oc) options.certificate.eps_oc = DecideAutoEpsOc(object, clouds, &outcomes);
+  if (auto_eps_oc) options.certificate.eps_oc = DecideAutoEpsOc(object, clouds, options.certificate.check_keypoint_agreement, &outcomes);
 
   std::ostringstream json_lines;
   int certified = 0, oc = 0, nd = 0, errors = 0;
