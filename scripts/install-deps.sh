@@ -7,7 +7,12 @@ packages=(build-essential cmake ninja-build ccache
           libeigen3-dev libnanoflann-dev libcli11-dev nlohmann-json3-dev doctest-dev
           libassimp-dev tiny-dnn)
 if [[ "${1:-}" != "--no-browser" ]]; then
-  packages+=(chromium nodejs npm)
+  packages+=(chromium)
+  # Node.js + npm run the browser tests (playwright-core from the npm registry);
+  # keep a Node.js that is already installed.
+  if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+    packages+=(nodejs npm)
+  fi
 fi
 SUDO=""
 if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
