@@ -22,6 +22,8 @@ json ParseJsonFile(const std::string& path) {
     return json::parse(text);
   } catch (const json::parse_error& e) {
     throw InputError(path, "not valid JSON (byte " + std::to_string(e.byte) + ")");
+  } catch (const json::exception& e) {   // e.g. a number out of range (1e400)
+    throw InputError(path, std::string("not valid JSON: ") + e.what());
   }
 }
 
