@@ -85,9 +85,9 @@ nlohmann::json PointsJson(const PointSet& points) {
   return list;
 }
 
-nlohmann::json EstimateJson(const std::string& cloud, const PoseEstimate& e) {
+nlohmann::ordered_json EstimateJson(const std::string& cloud, const PoseEstimate& e) {
   const Pose& T = e.scene_from_model;
-  nlohmann::json line;
+  nlohmann::ordered_json line;  // keys in the documented order, "cloud" first
   line["cloud"] = cloud;
   line["R"] = {{T.R(0, 0), T.R(0, 1), T.R(0, 2)}, {T.R(1, 0), T.R(1, 1), T.R(1, 2)}, {T.R(2, 0), T.R(2, 1), T.R(2, 2)}};
   line["t"] = {T.t(0), T.t(1), T.t(2)};
@@ -96,15 +96,15 @@ nlohmann::json EstimateJson(const std::string& cloud, const PoseEstimate& e) {
   line["nd"] = e.certificate.nd.passed;
   line["certified"] = e.certified();
   const double oc_distance = e.certificate.oc.max_point_distance;
-  line["oc_distance"] = std::isfinite(oc_distance) ? nlohmann::json(oc_distance) : nlohmann::json(nullptr);
+  line["oc_distance"] = std::isfinite(oc_distance) ? nlohmann::ordered_json(oc_distance) : nlohmann::ordered_json(nullptr);
   line["keypoint_distance"] = e.certificate.oc.max_keypoint_distance;
   line["nd_set"] = e.certificate.nd.passing_set;
   line["nd_set_distances"] = e.certificate.nd.set_worst_distance;
   line["eps_oc"] = e.certificate.oc.eps_oc;
   line["delta_nd"] = e.certificate.nd.delta_nd;
   line["iterations"] = e.correction.iterations;
-  line["cost_before"] = std::isfinite(e.correction.cost_before) ? nlohmann::json(e.correction.cost_before) : nlohmann::json(nullptr);
-  line["cost_after"] = std::isfinite(e.correction.cost_after) ? nlohmann::json(e.correction.cost_after) : nlohmann::json(nullptr);
+  line["cost_before"] = std::isfinite(e.correction.cost_before) ? nlohmann::ordered_json(e.correction.cost_before) : nlohmann::ordered_json(nullptr);
+  line["cost_after"] = std::isfinite(e.correction.cost_after) ? nlohmann::ordered_json(e.correction.cost_after) : nlohmann::ordered_json(nullptr);
   line["status"] = ToString(e.correction.registration);
   line["ms"] = e.milliseconds;
   return line;
