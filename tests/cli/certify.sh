@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# c3po certify end to end: --detector manifest on perturbed keypoints, exit
+# statuses 0/1/2, an unreadable cloud among good ones, JSON fields, -o atomic.
+# Usage: certify.sh C3PO_BIN SOURCE_DIR WORK_DIR
+set -euo pipefail
+C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
+rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
+OBJ="$SRC/annotations/drill.json"
+fail() { echo "FAIL: $*"; exit 1; }
+
+# Depth clouds whose detected keypoints are the ground truth slightly perturbed.
+"$C3PO" synth "$OBJ" -o good --kind depth --count 6 --pose easy --noise 0.0005 \
+        --perturb-sigma 0.05 --perturb-fraction 0.8 --seed 3 >/dev/null
+set +e
+"$C3PO" certify "$OBJ" --detector manifest --data good --json > good.jsonl 2> good.err
+status=$?
+set -e
+[ "$(wc -l < good.jsonl)" -eq 6 ] || fail "expected 6 JSON lines, got $(wc -l < good.jsonl)"
+for field in '"cloud"' '"R"' '"t"' '"keypoints"' '"oc"' '"nd"' '"certified"' '"oc_distance"' \
+             '"eps_oc"' '"delta_nd"' '"iterations"' '"ms"'; do
+  grep -q "$field" good.jsonl || fail "field $field missing"
+done
+certified=$(grep -c '"certified":true' good.jsonl || true)
+if [ "$certified" -eq 6 ]; then [ $status -eq 0 ] || fail "all certified but exit $status"
+else [ $status -eq 1 ] || fail "$certified/6 certified but exit $status"; fi
+[ "$certified" -ge 4 ] || fail "only $certified/6 mildly perturbed clouds certified"
+
+# Far-off keypoints: valid input, not certified => exit 1.
+"$C3PO" synth "$OBJ" -o bad --kind depth --count 3 --pose easy --perturb-sigma 3 --perturb-fraction 1 --seed 4 >/dev/null
+set +e; "$C3PO" certify "$OBJ" --detector manifest --data bad --no-correct > bad.txt 2>&1; status=$?; set -e
+[ $status -eq 1 ] || fail "hopeless keypoints: expected exit 1, got $status"
+grep -q "certified 0/3" bad.txt || fail "summary line missing: $(tail -1 bad.txt)"
+
+# An unreadable cloud among good ones: reported (exit 2), the others processed.
+cp good/000000.ply ok.ply
+printf 'ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nend_header\n' > broken.ply
+set +e; "$C3PO" certify "$OBJ" --detector svd ok.ply broken.ply --json > mixed.jsonl 2> mixed.err; status=$?; set -e
+[ $status -eq 2 ] || fail "unreadable cloud: expected exit 2, got $status"
+grep -q '"cloud":"ok.ply"' mixed.jsonl || fail "the good cloud was not processed"
+grep -q "broken.ply" mixed.err || fail "stderr does not name the broken file"
+
+# Usage errors: exit 2, one line, no output file left behind.
+set +e
+"$C3PO" certify "$OBJ" ok.ply > /dev/null 2> usage.err; s1=$?
+"$C3PO" certify "$OBJ" --detector svd ok.ply --eps-oc banana -o out.jsonl > /dev/null 2> eps.err; s2=$?
+"$C3PO" certify "$OBJ" --detector nosuch ok.ply > /dev/null 2> det.err; s3=$?
+set -e
+[ $s1 -eq 2 ] && [ $s2 -eq 2 ] && [ $s3 -eq 2 ] || fail "usage errors: exit $s1 $s2 $s3"
+[ "$(wc -l < eps.err)" -eq 1 ] || fail "eps error is not one line"
+grep -q -- "--eps-oc" eps.err || fail "eps error does not name the option"
+[ ! -e out.jsonl ] || fail "output written despite an error"
+
+# -o writes the JSON lines atomically, thresholds as given (3%d of the diameter).
+set +e; "$C3PO" certify "$OBJ" --detector manifest --data good --eps-oc 3%d -o out.jsonl > human.txt; set -e
+[ "$(wc -l < out.jsonl)" -eq 6 ] || fail "-o did not write 6 lines"
+grep -q "eps_oc = " human.txt || fail "human summary does not state eps_oc"
+echo "certify CLI: OK ($certified/6 certified with manifest keypoints)"
