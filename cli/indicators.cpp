@@ -123,6 +123,8 @@ int RunAuto(const IndicatorsCommand& cmd, ObjectModel& object) {
   }
   PrintScore("training", result.training_score);
   PrintScore("test    ", result.test_score);
+  PrintScore(spec.indicator_sets.empty() ? "test, the object's sets (none: nd = 1 always)" : "test, the object's current sets",
+             result.current_test_score);
   std::printf("  (test views: seed %llu, separate from the training views)\n",
               static_cast<unsigned long long>(result.test_seed));
   if (!cmd.write) return 0;
@@ -188,6 +190,8 @@ RunFunction SetupIndicators(CLI::App& command) {
                      "--auto: degenerate when a fitting pose is farther (Hausdorff) than this times eps_oc")->capture_default_str();
   command.add_option("--max-set-size", a.learning.max_set_size, "--auto: largest candidate set")->capture_default_str();
   command.add_option("--min-support", a.learning.min_support, "--auto: views a set must newly accept")->capture_default_str();
+  command.add_option("--borderline", a.learning.borderline_factor,
+                     "--auto: views with a fitting pose beyond this fraction of the tolerance also block sets (1 = off)")->capture_default_str();
   return [cmd]() { return Run(*cmd); };
 }
 

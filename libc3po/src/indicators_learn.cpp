@@ -79,7 +79,8 @@ class RendererPool {
   std::vector<std::unique_ptr<DepthRenderer>> free_;
 };
 
-std::vector<LabelledView> UsableLabels(const std::vector<ViewDegeneracy>& views, int* unusable) {
+std::vector<LabelledView> UsableLabels(const std::vector<ViewDegeneracy>& views, double borderline_distance,
+                                       int* unusable) {
   std::vector<LabelledView> labels;
   *unusable = 0;
   for (const ViewDegeneracy& view : views) {
@@ -87,7 +88,8 @@ std::vector<LabelledView> UsableLabels(const std::vector<ViewDegeneracy>& views,
       ++*unusable;
       continue;
     }
-    labels.push_back({view.seen_mask, view.degenerate});
+    labels.push_back({view.seen_mask, view.degenerate,
+                      !view.degenerate && view.worst_hausdorff > borderline_distance});
   }
   return labels;
 }
@@ -98,6 +100,7 @@ void SetLearningOptions::Check() const {
   if (max_set_size < 1 || max_set_size > 6) throw InputError("--max-set-size", "must be in [1, 6]");
   if (min_support < 1) throw InputError("--min-support", "must be at least 1");
   if (max_sets < 1) throw InputError("--max-sets", "must be at least 1");
+  if (!(borderline_factor > 0 && borderline_factor <= 1)) throw InputError("--borderline", "must be in (0, 1]");
 }
 
 void AutoIndicatorOptions::Check() const {
@@ -114,8 +117,12 @@ LearnedSets LearnIndicatorSets(const std::vector<LabelledView>& views, int num_k
   LearnedSets learned;
   std::vector<std::uint64_t> degenerate_seen;
   std::vector<std::uint64_t> uncovered;   // seen masks of non-degenerate views not yet accepted
-  for (const LabelledView& view : views) (view.degenerate ? degenerate_seen : uncovered).push_back(view.seen_mask);
-  if (degenerate_seen.empty()) {
+  bool any_degenerate = false;
+  for (const LabelledView& view : views) {
+    any_degenerate = any_degenerate || view.degenerate;
+    (view.degenerate || view.borderline ? degenerate_seen : uncovered).push_back(view.seen_mask);
+  }
+  if (!any_degenerate) {
     learned.accept_all = true;   // every training view pins the pose down: nd = 1 always
     return learned;
   }
@@ -198,6 +205,8 @@ std::string AutoIndicatorResult::EvidenceJson() const {
   doc["delta_nd"] = delta_nd;
   doc["noise_sigma"] = noise_sigma;
   doc["accept_all"] = learned.accept_all;
+  doc["previous_sets_precision"] = current_test_score.precision;
+  doc["previous_sets_recall"] = current_test_score.recall;
   return doc.dump();
 }
 
@@ -240,11 +249,14 @@ AutoIndicatorResult LearnIndicatorSetsFromViews(const ObjectModel& object,
     if (progress) progress(finished, static_cast<std::size_t>(total));
   });
 
-  const std::vector<LabelledView> training_labels = UsableLabels(result.training_views, &result.unusable_training_views);
-  const std::vector<LabelledView> test_labels = UsableLabels(result.test_views, &result.unusable_test_views);
+  const double borderline = options.learning.borderline_factor * degeneracy.tolerance_factor * degeneracy.eps_oc;
+  const std::vector<LabelledView> training_labels =
+      UsableLabels(result.training_views, borderline, &result.unusable_training_views);
+  const std::vector<LabelledView> test_labels = UsableLabels(result.test_views, borderline, &result.unusable_test_views);
   result.learned = LearnIndicatorSets(training_labels, object.num_keypoints(), options.learning);
   result.training_score = ScoreIndicatorSets(result.learned.sets, training_labels);
   result.test_score = ScoreIndicatorSets(result.learned.sets, test_labels);
+  result.current_test_score = ScoreIndicatorSets(object.spec().indicator_sets, test_labels);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;
 }

@@ -157,6 +157,15 @@ TEST_CASE("LearnIndicatorSets: no degenerate view means no sets; unreachable vie
   CHECK(impossible.admissible == 0);
 }
 
+TEST_CASE("a borderline view blocks the candidates it sees, like a degenerate one") {
+  // Keypoint 0 alone would accept both good views, but a borderline view sees it.
+  std::vector<LabelledView> views = {{0b011, false}, {0b101, false}, {0b000, true}};
+  CHECK(LearnIndicatorSets(views, 3, {}).sets == std::vector<IndicatorSet>{{0}});
+  views.push_back({0b001, false, true});
+  const LearnedSets learned = LearnIndicatorSets(views, 3, {});
+  for (const IndicatorSet& set : learned.sets) CHECK(set != IndicatorSet{0});
+}
+
 TEST_CASE("ScoreIndicatorSets counts against a direct tally") {
   const std::vector<LabelledView> views = {{0b001, false}, {0b011, true}, {0b110, false}, {0b000, true}};
   const SetScore s = ScoreIndicatorSets({{1}, {0, 2}}, views);

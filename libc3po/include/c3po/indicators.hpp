@@ -15,7 +15,8 @@
 //    makes exact symmetries harmless (a can turned about its axis is no error).
 // 2. Choose sets. Keypoint i is "seen" in a view when T*·b_i is within
 //    delta_nd of a cloud point. A candidate subset G is admissible when no
-//    degenerate training view sees all of G; greedy set cover picks the
+//    degenerate (or borderline, see LabelledView) training view sees all of G;
+//    greedy set cover picks the
 //    admissible candidate that accepts most not-yet-accepted non-degenerate
 //    views (ties: smaller sets first), until nothing new is accepted.
 #include <cstdint>
@@ -148,12 +149,17 @@ ViewDegeneracy AnalyzeViewDegeneracy(const ObjectModel& object, const PointSet& 
 struct LabelledView {
   std::uint64_t seen_mask = 0;
   bool degenerate = false;
+  // Non-degenerate, but some fitting pose is beyond borderline_factor times the
+  // degeneracy tolerance: such a view blocks candidates like a degenerate one
+  // (a safety margin against views just on the other side of the tolerance).
+  bool borderline = false;
 };
 
 struct SetLearningOptions {
   int max_set_size = 3;         // candidates: all subsets of 1..max_set_size keypoints
   int min_support = 2;          // a chosen set must accept at least this many new views
   int max_sets = 32;
+  double borderline_factor = 0.75;   // in (0, 1]; 1 = no margin
   void Check() const;
 };
 
@@ -195,6 +201,7 @@ struct AutoIndicatorResult {
   LearnedSets learned;
   SetScore training_score;
   SetScore test_score;
+  SetScore current_test_score;      // the object's own sets on the same test views
   double eps_oc = 0.0;              // the resolved thresholds
   double delta_nd = 0.0;
   double noise_sigma = 0.0;
