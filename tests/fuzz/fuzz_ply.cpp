@@ -1,0 +1,13 @@
+// libFuzzer target: c3po::ParseCloud on arbitrary bytes as PLY.
+#include "c3po/cloud_io.hpp"
+#include "c3po/error.hpp"
+#include "fuzz_common.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  try {
+    c3po::ParseCloud(c3po_fuzz::Bytes(data, size), c3po::CloudFormat::kPly, "fuzz.ply");
+  } catch (const c3po::InputError&) {
+    // expected for bad input
+  }
+  return 0;
+}
