@@ -1,5 +1,8 @@
 #pragma once
 // Helpers shared by unit tests: temporary folders, running the CLI, shared data.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -12,10 +15,11 @@ inline std::string Executable() { return C3PO_EXECUTABLE; }
 inline bool HaveSharedYcb() { return std::filesystem::exists(SharedData() + "/ycb"); }
 
 // A fresh empty folder under the test binary dir, removed on destruction.
+// Unique per process: ctest runs the cases of one file as parallel processes.
 class TempDir {
  public:
   explicit TempDir(const std::string& name) {
-    path_ = std::string(C3PO_TEST_BINARY_DIR) + "/tmp/" + name;
+    path_ = std::string(C3PO_TEST_BINARY_DIR) + "/tmp/" + name + "." + std::to_string(::getpid());
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
@@ -34,8 +38,10 @@ struct CommandResult {
 
 // Runs `c3po ARGS` through the shell, capturing stdout and stderr together.
 inline CommandResult RunC3po(const std::string& args) {
+  static int counter = 0;
+  std::filesystem::create_directories(std::string(C3PO_TEST_BINARY_DIR) + "/tmp");
   const std::string out = std::string(C3PO_TEST_BINARY_DIR) + "/tmp/.cmd_output_" +
-                          std::to_string(reinterpret_cast<std::uintptr_t>(&args));
+                          std::to_string(::getpid()) + "_" + std::to_string(counter++);
   const std::string command = Executable() + " " + args + " > " + out + " 2>&1";
   CommandResult result;
   const int raw = std::system(command.c_str());
