@@ -6,6 +6,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "c3po/auto_threshold.hpp"
 #include "c3po/dataset.hpp"
 #include "c3po/error.hpp"
 #include "c3po/object_io.hpp"
@@ -56,7 +57,8 @@ int Run(SelftrainCommand cmd) {
   SelfTrainOptions& options = cmd.options;
   options.pipeline.corrector.solver = ParseCorrectorSolver(cmd.solver);
   options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
-  if (!cmd.eps_oc_text.empty()) options.pipeline.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
+  const bool auto_eps_oc = cmd.eps_oc_text == "auto";
+  if (!cmd.eps_oc_text.empty() && !auto_eps_oc) options.pipeline.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
   if (!cmd.delta_nd_text.empty()) options.pipeline.certificate.delta_nd = ParseThreshold(cmd.delta_nd_text, object.diameter(), "--delta-nd");
   options.checkpoint_path = cmd.output_path + ".ckpt";
   try {
@@ -70,6 +72,22 @@ int Run(SelftrainCommand cmd) {
   const Dataset dataset = ReadDataset(cmd.data_dir);
   if (dataset.entries.size() < 2) throw InputError(cmd.data_dir, "need at least 2 clouds to self-train");
   const std::vector<PointSet> clouds = LoadDatasetClouds(dataset, "loading");
+  std::string eps_oc_evidence;
+  if (auto_eps_oc) {
+    // The paper's remark on tuning eps_oc: sensor noise + sampling density of
+    // B̂ (Theorem 12), and the oc distances of the sim-trained detector +
+    // corrector on the unlabelled clouds themselves.
+    const CertifiedFraction initial = MeasureCertified(object, clouds, *detector, options.pipeline);
+    std::vector<double> oc_distances;
+    for (const auto& estimate : initial.estimates) {
+      if (estimate.ok()) oc_distances.push_back(estimate.certificate.oc.max_point_distance);
+    }
+    const AutoEpsOcResult chosen = EstimateEpsOc(object, clouds, AutoEpsOcOptions{}, &oc_distances);
+    options.pipeline.certificate.eps_oc = chosen.eps_oc;
+    eps_oc_evidence = chosen.ToJson();
+    std::fprintf(stderr, "c3po selftrain: --eps-oc auto = %.6g (%s; eps_w = %.4g, eps_s = %.4g)\n", chosen.eps_oc,
+                 chosen.rule.c_str(), chosen.noise.eps_w, chosen.sampling.eps_s);
+  }
 
   EpochLogFile log(cmd.output_path);
   if (cmd.resume) log.LoadExisting();
@@ -92,7 +110,7 @@ int Run(SelftrainCommand cmd) {
       },
       [&](std::size_t done, std::size_t total) { progress.Update(total ? done / total : 0); }, cmd.resume);
   progress.Finish();
-  const nlohmann::json extra = {
+  nlohmann::json extra = {
       {"selftrained", true},
       {"selftrain", {{"source_model", std::filesystem::path(cmd.model_path).filename().string()},
                      {"eps_oc", options.pipeline.certificate.eps_oc},
@@ -101,6 +119,7 @@ int Run(SelftrainCommand cmd) {
                      {"initial_validation_percent_oc", result.initial_validation_percent_oc},
                      {"best_validation_percent_oc", result.best_validation_percent_oc},
                      {"stopped_early", result.stopped_early}}}};
+  if (!eps_oc_evidence.empty()) extra["selftrain"]["eps_oc_auto"] = nlohmann::json::parse(eps_oc_evidence);
   detector->Save(cmd.output_path, extra.dump());
   std::printf("wrote %s: validation %% oc %.1f -> %.1f (best epoch %d%s); eps_oc = %.6g; log %s\n",
               cmd.output_path.c_str(), result.initial_validation_percent_oc, result.best_validation_percent_oc,
@@ -124,7 +143,8 @@ RunFunction SetupSelftrain(CLI::App& command) {
   command.add_option("--optimizer", cmd->optimizer, "adam or sgd");
   command.add_option("--val-fraction", o.validation_fraction, "Held-out fraction of the unlabelled clouds");
   command.add_option("--stop-at", o.stop_at_percent_oc, "Stop when this % of the held-out clouds is observably correct");
-  command.add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold: distance or fraction of d (3%d)");
+  command.add_option("--eps-oc", cmd->eps_oc_text,
+                     "Observable-correctness threshold: distance, fraction of d (3%d) or auto (estimated from the clouds)");
   command.add_option("--delta-nd", cmd->delta_nd_text, "Non-degeneracy threshold");
   command.add_option("--solver", cmd->solver, "Corrector solver: fast or gd");
   command.add_option("--seed", o.seed, "Seed (split, shuffling)");
