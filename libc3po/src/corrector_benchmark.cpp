@@ -12,6 +12,7 @@
 #include "c3po/parallel.hpp"
 #include "c3po/pipeline.hpp"
 #include "c3po/random.hpp"
+#include "c3po/synth.hpp"
 
 namespace c3po {
 
@@ -26,19 +27,6 @@ void CorrectorBenchmarkOptions::Check() const {
 }
 
 namespace {
-
-// Eq. of the paper's corrector experiment: uniform noise on a random subset.
-PointSet PerturbKeypoints(const PointSet& keypoints, double sigma, double fraction, double d, Rng& rng) {
-  PointSet out = keypoints;
-  for (Eigen::Index i = 0; i < out.cols(); ++i) {
-    const bool perturb = rng.Uniform() < fraction;
-    for (int k = 0; k < 3; ++k) {
-      const double noise = rng.Uniform(-0.5, 0.5) * sigma * d;
-      if (perturb) out(k, i) += noise;
-    }
-  }
-  return out;
-}
 
 struct Sample {
   double rotation_deg, translation_over_d, adds_over_d, ms;

@@ -188,19 +188,22 @@ SynthSample SynthGenerator::GenerateDepth(Rng& rng, DepthRenderer* renderer) con
                    " attempts (object too small or too far: lower --min-points or --distance)");
 }
 
-void SynthGenerator::Perturb(SynthSample* sample, Rng& rng) const {
-  // Paper Section VIII-A: each keypoint, with probability F, moves by a noise
-  // uniform in [-sigma d / 2, sigma d / 2] per coordinate.
-  PointSet detected = sample->keypoints;
-  const double half_width = 0.5 * options_.perturb_sigma * diameter_;
+PointSet PerturbKeypoints(const PointSet& keypoints, double sigma, double fraction, double diameter, Rng& rng) {
+  PointSet detected = keypoints;
+  const double half_width = 0.5 * sigma * diameter;
   for (Eigen::Index i = 0; i < detected.cols(); ++i) {
-    const bool perturbed = rng.Uniform() < options_.perturb_fraction;
+    const bool perturbed = rng.Uniform() < fraction;
     const Eigen::Vector3d noise(rng.Uniform(-half_width, half_width),
                                 rng.Uniform(-half_width, half_width),
                                 rng.Uniform(-half_width, half_width));
     if (perturbed) detected.col(i) += noise;
   }
-  sample->detected_keypoints = std::move(detected);
+  return detected;
+}
+
+void SynthGenerator::Perturb(SynthSample* sample, Rng& rng) const {
+  sample->detected_keypoints =
+      PerturbKeypoints(sample->keypoints, options_.perturb_sigma, options_.perturb_fraction, diameter_, rng);
 }
 
 SynthSample SynthGenerator::Generate(std::size_t index, DepthRenderer* renderer) const {

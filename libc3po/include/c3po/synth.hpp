@@ -97,6 +97,11 @@ struct SynthSample {
 
 // Makes samples of one object; Generate(i) is a pure function of
 // (options.seed, i), so parallel runs are byte-identical to serial ones.
+// The paper's keypoint perturbation (Section VIII-A): each keypoint, with
+// probability `fraction`, moves by noise uniform in [-sigma d/2, sigma d/2]
+// per coordinate. Draws 4 numbers per keypoint whether perturbed or not.
+PointSet PerturbKeypoints(const PointSet& keypoints, double sigma, double fraction, double diameter, Rng& rng);
+
 class SynthGenerator {
  public:
   // `where` names the object in error messages. Throws InputError for a mesh
