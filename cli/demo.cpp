@@ -52,7 +52,14 @@ std::string SelfExecutable() {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   if (ec) throw InputError("c3po demo", "cannot locate the c3po executable: " + ec.message());
-  return self.string();
+  // Rebuilt while running: the kernel reports the old inode as "PATH (deleted)";
+  // the executable now at PATH is the same program.
+  std::string path = self.string();
+  const std::string deleted = " (deleted)";
+  if (path.size() > deleted.size() && path.compare(path.size() - deleted.size(), deleted.size(), deleted) == 0) {
+    path.resize(path.size() - deleted.size());
+  }
+  return path;
 }
 
 // Prints "$ c3po ARGS" and runs it; a failing step stops the demo.
