@@ -13,7 +13,7 @@ fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 
 "$C3PO" synth "$OBJ" -o sim --kind sim --count 1500 --points 400 --seed 1 >/dev/null 2>&1 || { echo "synth failed"; exit 2; }
 "$C3PO" synth "$OBJ" -o unlabelled --kind sim --count 800 --points 400 --noise 1%d --seed 2 >/dev/null 2>&1 || exit 2
-TRAIN=(--data sim --epochs 4 --point-mlp 64 64 --head 64 --points 256 --seed 7)
+TRAIN=(--data sim --epochs 4 --point-mlp 128 256 --head 256 --points 1024 --seed 7)
 SELF=(--model ref_train.model --data unlabelled --epochs 4 --seed 9)
 
 # interrupt NAME SIGNAL CMD...: starts CMD, sends SIGNAL once the first epoch
