@@ -49,7 +49,9 @@ ModelFile ReadModelFile(const std::string& path) {
     throw InputError(path, std::string("corrupt model header: ") + e.what());
   }
   const auto& h = file.header;
-  if (!h.is_object() || h.value("magic", "") != kModelMagic) {
+  // json::value() throws type_error for a non-string "magic": test the type first.
+  if (!h.is_object() || !h.contains("magic") || !h["magic"].is_string() ||
+      h["magic"].get<std::string>() != kModelMagic) {
     throw InputError(path, "not a c3po model file (magic is not \"c3po-model\")");
   }
   if (!h.contains("format_version") || !h["format_version"].is_number_integer() ||
