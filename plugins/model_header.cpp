@@ -24,7 +24,9 @@ std::string ReadModelDetectorName(const std::string& path) {
   } catch (const nlohmann::json::exception&) {
     throw InputError(path, "not a c3po model file (header is not JSON)");
   }
-  if (!header.is_object() || header.value("magic", "") != "c3po-model") {
+  // json::value() throws type_error for a non-string "magic": test the type first.
+  if (!header.is_object() || !header.contains("magic") || !header["magic"].is_string() ||
+      header["magic"].get<std::string>() != "c3po-model") {
     throw InputError(path, "not a c3po model file (missing magic \"c3po-model\")");
   }
   if (!header.contains("detector") || !header["detector"].is_string()) {

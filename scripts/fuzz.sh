@@ -29,6 +29,7 @@ for t in "${targets[@]}"; do
   exe=$build/tests/fuzz/fuzz_$t
   work=$build/fuzz-corpus/$t
   artifacts=$build/fuzz-artifacts/$t
+  rm -rf "$artifacts"   # findings of earlier runs are not this run's
   mkdir -p "$work" "$artifacts"
   log=$build/fuzz-logs/$t.log
   mkdir -p "$(dirname "$log")"

@@ -129,6 +129,9 @@ check model_truncated "2" - truncated.model truncated.model -- "$C3PO" certify "
 : > empty.model
 check model_empty "2" - empty.model empty.model -- "$C3PO" certify "$CUBE" --model empty.model sim/000000.ply
 
+cp "$SRC/tests/fuzz/corpus/model/regression_magic_not_string" magic_object.model
+check model_magic_not_string "2" - magic_object.model magic_object.model -- "$C3PO" certify "$CUBE" --model magic_object.model sim/000000.ply
+
 # --- outputs that cannot be written (ENOTDIR, see the note at the top) ------
 printf 'a regular file\n' > blocker
 check certify_output_unwritable "2" blocker/out.jsonl blocker sim -- "$C3PO" certify "$CUBE" --detector svd --data sim -o blocker/out.jsonl
