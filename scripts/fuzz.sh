@@ -36,9 +36,10 @@ for t in "${targets[@]}"; do
   # mesh: assimp 5.2's OBJ importer leaks on some malformed files (inside
   # libassimp, behind our RAII Importer; seed corpus/mesh/assimp_obj_leak);
   # leak checks there would only report that, so they are off for mesh.
-  extra=()
-  [ "$t" = mesh ] && extra=(-detect_leaks=0)
-  "$exe" "$work" "$src/tests/fuzz/corpus/$t" $(seeds_for "$t") "${extra[@]}" \
+  # (-detect_leaks=0 for libFuzzer, ASAN_OPTIONS for the check at exit).
+  extra=(); asan=${ASAN_OPTIONS:-}
+  [ "$t" = mesh ] && extra=(-detect_leaks=0) && asan=detect_leaks=0
+  ASAN_OPTIONS=$asan "$exe" "$work" "$src/tests/fuzz/corpus/$t" $(seeds_for "$t") "${extra[@]}" \
     -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
     -artifact_prefix="$artifacts/" >"$log" 2>&1
   runs=$(grep -m1 '^stat::number_of_executed_units' "$log" | awk '{print $2}')
