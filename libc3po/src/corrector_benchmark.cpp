@@ -90,7 +90,10 @@ std::vector<CorrectorBenchmarkRow> RunCorrectorBenchmark(const ObjectModel& obje
   std::vector<CorrectorBenchmarkRow> rows;
   for (std::size_t s = 0; s < options.sigmas.size(); ++s) {
     const double sigma = options.sigmas[s];
-    for (const auto& [method, solver] : methods) {
+    for (const auto& method_and_solver : methods) {
+      // Named copies: lambdas may not capture structured bindings in C++17.
+      const std::string& method = method_and_solver.first;
+      const std::optional<CorrectorSolver>& solver = method_and_solver.second;
       std::vector<Sample> samples(count);
       ParallelFor(0, static_cast<int>(count), [&](int i) {
         ThrowIfInterrupted();
