@@ -7,20 +7,7 @@
 # Usage: report_browser.sh C3PO_BIN SOURCE_DIR WORK_DIR
 set -euo pipefail
 C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
-PLAYWRIGHT_VERSION=1.56.1
-
-[ -x /usr/bin/chromium ] || { echo "SKIP: /usr/bin/chromium not found (apt-get install chromium)"; exit 77; }
-command -v node >/dev/null || { echo "SKIP: node not found (apt-get install nodejs npm)"; exit 77; }
-
-rm -rf "$WORK"; mkdir -p "$WORK"
-# playwright-core is installed once per build tree, next to the work folders.
-PW_DIR=$(dirname "$WORK")/playwright-core-$PLAYWRIGHT_VERSION
-if [ ! -f "$PW_DIR/node_modules/playwright-core/index.mjs" ]; then
-  command -v npm >/dev/null || { echo "SKIP: npm not found to install playwright-core"; exit 77; }
-  if ! npm install --silent --no-audit --no-fund --prefix "$PW_DIR" "playwright-core@$PLAYWRIGHT_VERSION" >"$WORK/npm.log" 2>&1; then
-    echo "SKIP: cannot install playwright-core@$PLAYWRIGHT_VERSION (offline?):"; tail -3 "$WORK/npm.log"; exit 77
-  fi
-fi
+source "$SRC/tests/browser/playwright_setup.sh"
 
 cd "$WORK"
 OBJECT="$SRC/annotations/mug.json"
