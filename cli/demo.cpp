@@ -62,9 +62,11 @@ std::string SelfExecutable() {
   return path;
 }
 
-// Prints "$ c3po ARGS" and runs it; a failing step stops the demo.
-void Step(const std::string& title, const std::vector<std::string>& args) {
+// Prints "$ c3po ARGS" and runs it; a failing step stops the demo. Returns
+// the step's wall-clock seconds.
+double Step(const std::string& title, const std::vector<std::string>& args) {
   ThrowIfInterrupted();
+  const auto start = std::chrono::steady_clock::now();
   std::string shown = "$ c3po";
   for (const auto& a : args) shown += " " + a;
   std::printf("\n== %s\n%s\n", title.c_str(), shown.c_str());
@@ -88,6 +90,9 @@ void Step(const std::string& title, const std::vector<std::string>& args) {
   if (code != 0 && !(certify && code == 1)) {
     throw InputError("c3po demo", "step '" + title + "' failed with exit status " + std::to_string(code));
   }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("(took %.1f s)\n", seconds);
+  return seconds;
 }
 
 int Run(DemoCommand cmd) {
@@ -108,7 +113,7 @@ int Run(DemoCommand cmd) {
   Step("1. simulated training data: uniform surface samples, random poses",
        {"synth", cmd.object, "-o", o + "sim", "--kind", "sim", "--count", std::to_string(cmd.sim_count),
         "--points", "1000", "--pose", cmd.pose, "--seed", seed});
-  Step("2. supervised training of the PointNet detector on sim data",
+  const double train_seconds = Step("2. supervised training of the PointNet detector on sim data",
        {"train", cmd.object, "--data", o + "sim", "-o", o + "sim.model", "--epochs", std::to_string(cmd.train_epochs),
         "--batch", "32", "--lr", "0.001", "--seed", seed});
   Step("3. 'real' data: rendered depth clouds (1 mm noise, 10 % dropout); labels are never used for training",
@@ -120,7 +125,7 @@ int Run(DemoCommand cmd) {
         "--pose", cmd.pose, "--noise", "1mm", "--dropout", "0.1", "--seed", std::to_string(cmd.seed + 2)});
   Step("5. KeyPo (sim) on depth clouds: detector + registration, + ICP, + corrector",
        {"eval", cmd.object, "--model", o + "sim.model", "--data", o + "depth_test"});
-  Step("6. self-training on the unlabelled depth clouds from certified outputs",
+  const double selftrain_seconds = Step("6. self-training on the unlabelled depth clouds from certified outputs",
        {"selftrain", cmd.object, "--model", o + "sim.model", "--data", o + "depth_train", "-o", o + "self.model",
         "--epochs", std::to_string(cmd.selftrain_epochs), "--seed", seed});
   Step("7. the supervised bound (for comparison only): the same network trained on the labelled depth clouds",
@@ -135,7 +140,9 @@ int Run(DemoCommand cmd) {
         o + "depth_test", "--report", o + "report.html", "--json", o + "eval.json"});
   const double minutes =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / 60.0;
-  std::printf("\ndemo finished in %.1f min. Report: %sreport.html  Models: %ssim.model, %sself.model\n", minutes,
+  std::printf("\ntraining on sim data %.1f min + self-training %.1f min = %.1f min\n", train_seconds / 60.0,
+              selftrain_seconds / 60.0, (train_seconds + selftrain_seconds) / 60.0);
+  std::printf("demo finished in %.1f min. Report: %sreport.html  Models: %ssim.model, %sself.model\n", minutes,
               o.c_str(), o.c_str(), o.c_str());
   return 0;
 }
