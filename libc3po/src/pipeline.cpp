@@ -1,12 +1,28 @@
 #include "c3po/pipeline.hpp"
 
 #include <chrono>
+#include <stdexcept>
 
 #include "c3po/registration.hpp"
 
 namespace c3po {
 
+namespace {
+
+// Columns floor(j n / k), j = 0..k-1, k = min(n, limit); the cloud itself
+// when it has at most `limit` columns or limit is 0.
+PointSet StridedColumns(const PointSet& cloud, int limit) {
+  const Eigen::Index n = cloud.cols();
+  if (limit <= 0 || n <= limit) return cloud;
+  PointSet subset(3, limit);
+  for (Eigen::Index j = 0; j < limit; ++j) subset.col(j) = cloud.col(j * n / limit);
+  return subset;
+}
+
+}  // namespace
+
 void PipelineOptions::Check() const {
+  if (max_corrector_points < 0) throw std::invalid_argument("max_corrector_points must be >= 0");
   corrector.Check();
   certificate.Check();
 }
@@ -17,14 +33,15 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
   const auto start = std::chrono::steady_clock::now();
   PoseEstimate estimate;
   estimate.detected_keypoints = detected_keypoints;
+  const PointSet corrector_cloud = StridedColumns(cloud, options.max_corrector_points);
   if (options.correct) {
-    estimate.correction = CorrectKeypoints(object, cloud, detected_keypoints, options.corrector);
+    estimate.correction = CorrectKeypoints(object, corrector_cloud, detected_keypoints, options.corrector);
   } else {
     // Registration only: y* = ỹ, T̂ = T(ỹ).
     CorrectorOptions no_iterations = options.corrector;
     no_iterations.solver = CorrectorSolver::kGradientDescent;
     no_iterations.gd_max_iterations = 0;
-    estimate.correction = CorrectKeypoints(object, cloud, detected_keypoints, no_iterations);
+    estimate.correction = CorrectKeypoints(object, corrector_cloud, detected_keypoints, no_iterations);
   }
   estimate.keypoints = estimate.correction.keypoints;
   estimate.scene_from_model = estimate.correction.scene_from_model;

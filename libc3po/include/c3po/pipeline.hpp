@@ -11,6 +11,10 @@ struct PipelineOptions {
   CorrectorOptions corrector;
   CertificateOptions certificate;
   bool correct = true;    // false: certify the plain registration T(ỹ)
+  // The corrector sees at most this many input points, evenly strided (0 =
+  // all), so huge clouds (10^7 points) cost a bounded amount; the
+  // certificates always check every input point (their definition).
+  int max_corrector_points = 20000;
   void Check() const;
 };
 

@@ -18,15 +18,22 @@ namespace {
 // Cloud subsample that measures the cloud's extent for box-aligned translations.
 constexpr int kExtentPoints = 2000;
 
-PointSet FiniteColumns(const PointSet& points) {
-  std::vector<Eigen::Index> keep;
-  keep.reserve(points.cols());
-  for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    if (points.col(i).allFinite()) keep.push_back(i);
+// The finite columns, evenly strided down to at most `limit` of them (0 = no
+// limit): the finite points of rank floor(j m / k), j = 0..k-1, of the m
+// finite ones. Deterministic, one pass over the input plus one to count; with
+// m <= limit every finite column is kept, in order.
+PointSet FiniteStridedColumns(const PointSet& points, int limit) {
+  Eigen::Index finite = 0;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) finite += points.col(i).allFinite() ? 1 : 0;
+  const Eigen::Index kept = limit > 0 ? std::min<Eigen::Index>(finite, limit) : finite;
+  PointSet subset(3, kept);
+  Eigen::Index rank = 0, next = 0;
+  for (Eigen::Index i = 0; i < points.cols() && next < kept; ++i) {
+    if (!points.col(i).allFinite()) continue;
+    if (rank == next * finite / kept) subset.col(next++) = points.col(i);
+    ++rank;
   }
-  PointSet finite(3, static_cast<Eigen::Index>(keep.size()));
-  for (std::size_t k = 0; k < keep.size(); ++k) finite.col(k) = points.col(keep[k]);
-  return finite;
+  return subset;
 }
 
 // At most `count` distinct columns, chosen by a partial Fisher-Yates shuffle.
@@ -68,6 +75,7 @@ void SvdDetectorOptions::Check() const {
     if (!ok) throw std::invalid_argument(std::string("SvdDetectorOptions: ") + what);
   };
   require(uniform_rotations >= 0, "uniform_rotations must be >= 0");
+  require(max_input_points == 0 || max_input_points >= 100, "max_input_points must be 0 or >= 100");
   require(coarse_model_points >= 100, "coarse_model_points must be >= 100");
   require(grid_cells >= 2 && grid_cells <= 256, "grid_cells must be in [2, 256]");
   require(screening_points >= 3 && max_hypothesis_points >= 3 && max_final_points >= 3,
@@ -166,7 +174,8 @@ std::vector<SvdDetector::Candidate> SvdDetector::Screen(const PointSet& points,
 }
 
 SvdEstimate SvdDetector::Estimate(const PointSet& cloud) const {
-  const PointSet points = FiniteColumns(cloud);
+  // Huge clouds: every later stage (and the evidence) sees a strided subset.
+  const PointSet points = FiniteStridedColumns(cloud, options_.max_input_points);
   if (points.cols() == 0) {
     throw InputError("cloud", "svd detector needs at least one finite point, got none of " +
                                   std::to_string(cloud.cols()));
@@ -212,7 +221,7 @@ SvdEstimate SvdDetector::Estimate(const PointSet& cloud) const {
       estimate.best_hypothesis = order[k];
     }
   }
-  // Evidence on the whole cloud: eq. (9) to the posed B̂.
+  // Evidence on every used point (all finite ones up to max_input_points): eq. (9) to the posed B̂.
   Eigen::VectorXd squared;
   object_.NearestInPosedModel(points, estimate.scene_from_model, nullptr, &squared);
   estimate.chamfer = squared.mean();

@@ -32,6 +32,10 @@ namespace c3po {
 class DistanceGrid;
 
 struct SvdDetectorOptions {
+  // Clouds with more finite points are first reduced to this many by an even
+  // stride over the finite points (0 = never): the detector's cost is then
+  // bounded for huge clouds (10^7 points); smaller clouds are used whole.
+  int max_input_points = 5000;
   bool try_permutations = true;   // 24 axis rotations; false: the 4 sign flips only
   int uniform_rotations = 120;    // extra rotations, uniform on SO(3) (fixed by seed)
   bool box_translations = true;   // 27 translations per rotation; false: centroids only
@@ -59,7 +63,7 @@ struct SvdHypothesis {
 
 struct SvdEstimate {
   Pose scene_from_model;
-  double chamfer = 0.0;      // eq. (9), every finite cloud point -> posed B̂, final pose
+  double chamfer = 0.0;      // eq. (9), every used finite cloud point -> posed B̂, final pose
   int screened = 0;          // (rotation, translation) pairs screened in stage 1
   int best_hypothesis = -1;  // index into hypotheses of the winner
   std::vector<SvdHypothesis> hypotheses;   // stage-2 results
@@ -72,7 +76,8 @@ class SvdDetector : public Detector {
 
   std::string name() const override { return "svd"; }
   int num_keypoints() const override { return object_.num_keypoints(); }
-  // Posed keypoints (3 x N). Non-finite points are ignored. With 1 or 2 finite
+  // Posed keypoints (3 x N). Non-finite points are ignored; more than
+  // max_input_points finite ones are strided down to that many. With 1 or 2 finite
   // points (no axes) the model is only translated onto the cloud centroid.
   // Throws InputError("cloud: ...") when the cloud has no finite point.
   // Safe to call concurrently; the same cloud always gives the same output.
