@@ -39,6 +39,8 @@ void CorrectorOptions::Check() const {
   require(fast_max_iterations >= 0, "fast_max_iterations must be >= 0");
   require(fast_tolerance >= 0, "fast_tolerance must be >= 0");
   require(fast_subsample >= 0, "fast_subsample must be >= 0");
+  require(fast_coarse_subsample >= 0, "fast_coarse_subsample must be >= 0");
+  require(fast_basin_iterations >= 0, "fast_basin_iterations must be >= 0");
 }
 
 namespace {
@@ -52,41 +54,47 @@ PointSet StridedSubset(const PointSet& cloud, int max_points) {
   return subset;
 }
 
+// L_pc of `points` at `pose`, with the nearest B̂ point of every input point.
 struct PoseFit {
+  Pose pose;
+  Eigen::VectorXi nearest;
+  Eigen::VectorXd squared;
   double loss = std::numeric_limits<double>::infinity();
-  Eigen::VectorXd squared;       // per point
-  PointSet matched_model_points; // nearest B̂ point of each input point (model frame)
 };
 
-PoseFit FitAtPose(const ObjectModel& object, const PointSet& cloud, const Pose& pose,
+PoseFit FitAtPose(const ObjectModel& object, const PointSet& points, const Pose& pose,
                   PointCloudLoss loss) {
   PoseFit fit;
-  Eigen::VectorXi nearest;
-  object.NearestInPosedModel(cloud, pose, &nearest, &fit.squared);
-  fit.matched_model_points.resize(3, cloud.cols());
-  for (Eigen::Index j = 0; j < cloud.cols(); ++j) {
-    fit.matched_model_points.col(j) = object.sample().col(nearest(j));
+  fit.pose = pose;
+  object.NearestInPosedModel(points, pose, &fit.nearest, &fit.squared);
+  if (points.cols() > 0) {
+    fit.loss = loss == PointCloudLoss::kMeanSquared ? fit.squared.mean() : fit.squared.maxCoeff();
   }
-  fit.loss = loss == PointCloudLoss::kMeanSquared ? fit.squared.mean() : fit.squared.maxCoeff();
   return fit;
 }
 
-// One stage of majorise-minimise steps on a fixed point set: re-associate,
-// then the weighted closed-form registration of eq. (8). With unit weights
-// each step cannot increase the mean loss (ICP); with IRLS weights
-// w_j = d_j^(p-2) it minimises sum d_j^p, which tends to the max loss.
 struct StageResult {
-  Pose pose;
-  double loss;
-  int iterations = 0;
+  PoseFit best;          // lowest loss seen in the stage
+  int iterations = 0;    // candidate poses evaluated
   bool converged = false;
 };
 
-StageResult RunStage(const ObjectModel& object, const PointSet& points, Pose pose,
-                     PointCloudLoss loss, double irls_power, int max_iterations,
-                     double tolerance) {
-  PoseFit fit = FitAtPose(object, points, pose, loss);
-  StageResult best{pose, fit.loss};
+bool SmallDecrease(double previous, double current, double tolerance) {
+  return std::abs(previous - current) <= tolerance * std::max(previous, 1e-300);
+}
+
+// Majorise-minimise (ICP) steps on a fixed point set: re-associate, then the
+// weighted closed-form registration of eq. (8). With unit weights no step can
+// increase the mean loss, and each step only moves as far as the current
+// matches pull, so the iterates stay in the basin of the start (this is what
+// the reference's small gradient steps achieve, in far fewer iterations).
+// With IRLS weights w_j = d_j^(p-2) it minimises sum d_j^p, which tends to
+// the max loss.
+StageResult RunPointToPointStage(const ObjectModel& object, const PointSet& points, PoseFit fit,
+                                 PointCloudLoss loss, double irls_power, int max_iterations,
+                                 double tolerance) {
+  StageResult stage{fit};
+  PointSet matched(3, points.cols());
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     Eigen::VectorXd weights;
     if (irls_power > 2.0) {
@@ -94,134 +102,160 @@ StageResult RunStage(const ObjectModel& object, const PointSet& points, Pose pos
       weights = (fit.squared / scale).array().pow(0.5 * (irls_power - 2.0)).matrix();
       weights = weights.cwiseMax(1e-12);
     }
-    const RegistrationResult step = RegisterPoints(fit.matched_model_points, points, weights);
-    ++best.iterations;
+    for (Eigen::Index j = 0; j < points.cols(); ++j) matched.col(j) = object.sample().col(fit.nearest(j));
+    const RegistrationResult step = RegisterPoints(matched, points, weights);
     if (!step.ok()) break;
-    pose = step.scene_from_model;
     const double previous = fit.loss;
-    fit = FitAtPose(object, points, pose, loss);
-    if (fit.loss < best.loss) {
-      best.pose = pose;
-      best.loss = fit.loss;
-    }
-    if (std::abs(previous - fit.loss) <= tolerance * std::max(previous, 1e-300)) {
-      best.converged = true;
+    fit = FitAtPose(object, points, step.scene_from_model, loss);
+    ++stage.iterations;
+    if (fit.loss < stage.best.loss) stage.best = fit;
+    if (SmallDecrease(previous, fit.loss, tolerance)) {
+      stage.converged = true;
       break;
     }
   }
-  return best;
+  return stage;
 }
 
-// Gauss-Newton on the point-to-plane residuals r_j = m_j·(x_j - s_j), with
-// s_j = R p_j + t the nearest posed sample point and m_j = R n_j its normal.
-// For the update R <- Exp(ω) R, t <- Exp(ω) t + v the Jacobian of r_j is
-// [ (m_j × x_j)^T, -m_j^T ] (the normal moves with the model). Converges in a
-// few steps near the optimum; the point-to-point stage then polishes.
-StageResult RunPointToPlaneStage(const ObjectModel& object, const PointSet& points, Pose pose,
-                                 int max_iterations, double tolerance) {
-  StageResult best{pose, std::numeric_limits<double>::infinity()};
-  double previous = std::numeric_limits<double>::infinity();
-  Eigen::VectorXi nearest;
-  Eigen::VectorXd squared;
-  // One nearest-neighbour query per step: it gives both the loss at the
-  // current pose and the linearisation for the next step.
-  for (int iteration = 0; iteration <= max_iterations; ++iteration) {
-    object.NearestInPosedModel(points, pose, &nearest, &squared);
-    const double loss = squared.mean();
-    if (loss < best.loss) {
-      best.loss = loss;
-      best.pose = pose;
-    }
-    if (std::isfinite(previous) && std::abs(previous - loss) <= tolerance * std::max(previous, 1e-300)) {
-      best.converged = true;
-      break;
-    }
-    if (iteration == max_iterations) break;
-    previous = loss;
+// R <- Exp(ω) R, t <- Exp(ω) t + v for delta = (ω, v).
+Pose ApplyIncrement(const Pose& pose, const Eigen::Matrix<double, 6, 1>& delta) {
+  const double angle = delta.head<3>().norm();
+  const Eigen::Matrix3d step_rotation =
+      angle > 0 ? Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix()
+                : Eigen::Matrix3d::Identity();
+  Pose out;
+  out.R = step_rotation * pose.R;
+  out.t = step_rotation * pose.t + delta.tail<3>();
+  return out;
+}
+
+// Levenberg-Marquardt on the point-to-plane residuals r_j = m_j·(x_j - s_j),
+// with s_j = R p_j + t the nearest posed sample point and m_j = R n_j its
+// normal; for the increment of ApplyIncrement the Jacobian of r_j is
+// [ (m_j × x_j)^T, -m_j^T ] (the normal moves with the model). A step is
+// accepted only if the true mean loss L_pc (re-associated) decreases;
+// otherwise the damping grows tenfold, at most `max_tries` times. Undamped
+// Gauss-Newton converges in a few steps near the optimum but from afar can
+// jump out of the start's basin; the acceptance test forbids that.
+StageResult RunPointToPlaneStage(const ObjectModel& object, const PointSet& points, PoseFit fit,
+                                 int max_iterations, double tolerance, int max_tries) {
+  StageResult stage;
+  double damping = 1e-4;
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
     Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> Jtr = Eigen::Matrix<double, 6, 1>::Zero();
     for (Eigen::Index j = 0; j < points.cols(); ++j) {
       const Eigen::Vector3d x = points.col(j);
-      const Eigen::Vector3d m = pose.R * object.sample_normals().col(nearest(j));
-      const Eigen::Vector3d s = pose.R * object.sample().col(nearest(j)) + pose.t;
+      const Eigen::Vector3d m = fit.pose.R * object.sample_normals().col(fit.nearest(j));
+      const Eigen::Vector3d s = fit.pose.R * object.sample().col(fit.nearest(j)) + fit.pose.t;
       Eigen::Matrix<double, 6, 1> J;
       J << m.cross(x), -m;
-      const double r = m.dot(x - s);
       JtJ.noalias() += J * J.transpose();
-      Jtr.noalias() += J * r;
+      Jtr.noalias() += J * m.dot(x - s);
     }
-    // Levenberg damping keeps the step bounded on near-degenerate views.
-    JtJ.diagonal().array() += 1e-6 * (JtJ.trace() / 6.0 + 1e-12);
-    const Eigen::Matrix<double, 6, 1> delta = JtJ.ldlt().solve(-Jtr);
-    if (!delta.allFinite()) break;
-    const double angle = delta.head<3>().norm();
-    const Eigen::Matrix3d step_rotation =
-        angle > 0 ? Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix()
-                  : Eigen::Matrix3d::Identity();
-    pose.R = step_rotation * pose.R;
-    pose.t = step_rotation * pose.t + delta.tail<3>();
-    ++best.iterations;
+    const double floor = 1e-12 * (JtJ.trace() + 1e-300);
+    bool accepted = false;
+    const double previous = fit.loss;
+    for (int attempt = 0; attempt < max_tries && !accepted; ++attempt) {
+      Eigen::Matrix<double, 6, 6> damped = JtJ;
+      damped.diagonal() += damping * JtJ.diagonal().cwiseMax(floor);
+      const Eigen::Matrix<double, 6, 1> delta = damped.ldlt().solve(-Jtr);
+      if (!delta.allFinite()) break;
+      PoseFit candidate = FitAtPose(object, points, ApplyIncrement(fit.pose, delta),
+                                    PointCloudLoss::kMeanSquared);
+      ++stage.iterations;
+      if (candidate.loss < fit.loss) {
+        fit = std::move(candidate);
+        damping = std::max(damping / 3.0, 1e-7);
+        accepted = true;
+      } else {
+        damping *= 10.0;
+      }
+    }
+    // No descent step at this resolution: a (numerical) local minimum.
+    if (!accepted || SmallDecrease(previous, fit.loss, tolerance)) {
+      stage.converged = true;
+      break;
+    }
   }
-  return best;
+  stage.best = std::move(fit);
+  return stage;
+}
+
+// Fills the result for y* = T·b: then L_kp = 0, T(y*) = T and f = kappa L_pc(T)
+// (corrector.hpp); `fit` is L_pc of the whole cloud at T.
+CorrectorResult FinishAtPose(const ObjectModel& object, const PoseFit& fit,
+                             const CorrectorOptions& options, CorrectorResult result) {
+  const PointSet posed = fit.pose * object.keypoints();
+  const RegistrationResult registration = RegisterPoints(object.keypoints(), posed);
+  result.keypoints = posed;
+  result.scene_from_model = registration.ok() ? registration.scene_from_model : fit.pose;
+  result.posed_keypoints = result.scene_from_model * object.keypoints();
+  result.point_cloud_loss = fit.loss;
+  result.keypoint_loss = (posed - result.posed_keypoints).squaredNorm() / posed.cols();
+  result.cost_after = options.kappa * result.point_cloud_loss + options.theta * result.keypoint_loss;
+  return result;
+}
+
+// Mean loss, coarse to fine: (1) ICP steps on a small subset find the basin of
+// the start, (2) damped point-to-plane steps on a larger subset converge in
+// it, (3) the same on every point, accepted only if L_pc decreases, (4) a
+// couple of ICP steps on every point, the objective itself.
+CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, const Pose& start,
+                              const CorrectorOptions& options, CorrectorResult result) {
+  const PointSet coarse = StridedSubset(cloud, options.fast_coarse_subsample);
+  const PointSet subset = StridedSubset(cloud, options.fast_subsample);
+  const PointCloudLoss mean = PointCloudLoss::kMeanSquared;
+  int budget = options.fast_max_iterations;
+  auto spend = [&budget](const StageResult& stage) { budget = std::max(0, budget - stage.iterations); };
+
+  const StageResult basin = RunPointToPointStage(object, coarse, FitAtPose(object, coarse, start, mean),
+                                                 mean, 2.0, std::min(budget, options.fast_basin_iterations), 1e-3);
+  spend(basin);
+  const StageResult local = RunPointToPlaneStage(object, subset, FitAtPose(object, subset, basin.best.pose, mean),
+                                                 std::min(budget, 25), 1e-3, 4);
+  spend(local);
+  const StageResult fine = RunPointToPlaneStage(object, cloud, FitAtPose(object, cloud, local.best.pose, mean),
+                                                std::min(budget, 5), 1e-4, 1);
+  spend(fine);
+  const StageResult polish = RunPointToPointStage(object, cloud, fine.best, mean, 2.0, std::min(budget, 2),
+                                                  options.fast_tolerance);
+  result.iterations = basin.iterations + local.iterations + fine.iterations + polish.iterations;
+  result.converged = fine.converged;
+  return FinishAtPose(object, polish.best, options, result);
+}
+
+// Max loss: ICP on a subset (mean loss) finds the basin, then an IRLS
+// continuation towards the max, p = 4, 8, 16, 32; keep the pose with the
+// lowest true max loss (the start included).
+CorrectorResult SolveFastMax(const ObjectModel& object, const PointSet& cloud, const Pose& start,
+                             const CorrectorOptions& options, CorrectorResult result) {
+  const PointSet subset = StridedSubset(cloud, options.fast_subsample);
+  const int budget = options.fast_max_iterations;
+  const StageResult mean_stage =
+      RunPointToPointStage(object, subset, FitAtPose(object, subset, start, PointCloudLoss::kMeanSquared),
+                           PointCloudLoss::kMeanSquared, 2.0, budget / 4, 1e-4);
+  int iterations = mean_stage.iterations;
+  PoseFit best = FitAtPose(object, cloud, start, options.loss);
+  PoseFit current = FitAtPose(object, cloud, mean_stage.best.pose, options.loss);
+  if (current.loss < best.loss) best = current;
+  for (double power : {4.0, 8.0, 16.0, 32.0}) {
+    const int stage_budget = std::max(1, (budget - iterations) / 4);
+    const StageResult stage = RunPointToPointStage(object, cloud, current, options.loss, power,
+                                                   stage_budget, options.fast_tolerance);
+    iterations += stage.iterations;
+    result.converged = stage.converged;
+    current = stage.best;
+    if (current.loss < best.loss) best = current;
+  }
+  result.iterations = iterations;
+  return FinishAtPose(object, best, options, result);
 }
 
 CorrectorResult SolveFast(const ObjectModel& object, const PointSet& cloud, const Pose& start,
                           const CorrectorOptions& options, CorrectorResult result) {
-  Pose pose = start;
-  int iterations = 0;
-  bool converged = false;
-  const PointSet subset = StridedSubset(cloud, options.fast_subsample);
-  const int budget = options.fast_max_iterations;
-  if (options.loss == PointCloudLoss::kMeanSquared) {
-    // Coarse: point-to-plane Gauss-Newton on a subset; fine: point-to-point
-    // majorise-minimise steps on every point (the objective itself).
-    const StageResult coarse = RunPointToPlaneStage(object, subset, pose, budget / 4, 1e-3);
-    pose = coarse.pose;
-    iterations += coarse.iterations;
-    const StageResult fine = RunPointToPlaneStage(object, cloud, pose, budget / 4, 1e-4);
-    pose = fine.pose;
-    iterations += fine.iterations;
-    const StageResult polish = RunStage(object, cloud, pose, options.loss, 2.0,
-                                        std::min(10, budget - iterations), options.fast_tolerance);
-    pose = polish.pose;
-    iterations += polish.iterations;
-    converged = fine.converged;
-  } else {
-    // IRLS continuation towards the max: p = 2, 4, 8, 16, 32, then keep the
-    // pose with the lowest true max loss.
-    const StageResult mean_stage = RunStage(object, subset, pose, PointCloudLoss::kMeanSquared,
-                                            2.0, budget / 4, 1e-4);
-    pose = mean_stage.pose;
-    iterations += mean_stage.iterations;
-    Pose best_pose = start;
-    double best_loss = FitAtPose(object, cloud, start, options.loss).loss;
-    for (double power : {4.0, 8.0, 16.0, 32.0}) {
-      const int stage_budget = std::max(1, (budget - iterations) / 4);
-      const StageResult stage = RunStage(object, cloud, pose, options.loss, power, stage_budget,
-                                         options.fast_tolerance);
-      pose = stage.pose;
-      iterations += stage.iterations;
-      converged = stage.converged;
-      if (stage.loss < best_loss) {
-        best_loss = stage.loss;
-        best_pose = stage.pose;
-      }
-    }
-    pose = best_pose;
-  }
-  // Return y* = T·b: L_kp = 0 and f = kappa L_pc(T) (corrector.hpp).
-  const PointSet posed = pose * object.keypoints();
-  const CorrectorObjectiveTerms final_terms =
-      EvaluateCorrectorObjective(object, cloud, posed, options);
-  result.keypoints = posed;
-  result.scene_from_model = final_terms.scene_from_model;
-  result.posed_keypoints = posed;
-  result.cost_after = final_terms.value;
-  result.point_cloud_loss = final_terms.point_cloud_loss;
-  result.keypoint_loss = final_terms.keypoint_loss;
-  result.iterations = iterations;
-  result.converged = converged;
-  return result;
+  if (options.loss == PointCloudLoss::kMeanSquared) return SolveFastMean(object, cloud, start, options, result);
+  return SolveFastMax(object, cloud, start, options, result);
 }
 
 // The reference solver: Δy <- Δy - step ∇f(ỹ + Δy) from Δy = 0.

@@ -24,7 +24,7 @@ enum class PointCloudLoss {
   kMaxSquared,   // the reference code: max_x min_p ||x - T p||^2
 };
 enum class CorrectorSolver {
-  kFast,             // pose-space ICP/IRLS steps (Gauss-Newton majorisation), see above
+  kFast,             // pose-space ICP + damped point-to-plane steps (mean), IRLS (max); see above
   kGradientDescent,  // the reference: fixed step in keypoint space
 };
 const char* ToString(PointCloudLoss loss);
@@ -41,12 +41,18 @@ struct CorrectorOptions {
   double gd_step = 0.1;
   int gd_max_iterations = 1000;
   double gd_tolerance = 1e-12;
-  // fast: stop when the relative decrease of L_pc is below fast_tolerance.
+  // fast (mean loss), coarse to fine: (1) at most fast_basin_iterations ICP
+  // steps on fast_coarse_subsample points keep the start's basin, (2) damped
+  // point-to-plane steps on fast_subsample points, each accepted only if L_pc
+  // decreases, (3) the same on every point, (4) two ICP steps on every point.
+  // fast_max_iterations bounds the candidate poses evaluated in all stages;
+  // the last stage stops when the relative decrease of L_pc < fast_tolerance.
+  // 0 subsample = every point.
   int fast_max_iterations = 100;
   double fast_tolerance = 1e-5;
-  // fast: at most this many input points in the early iterations (0 = all);
-  // the last iterations always use every point.
   int fast_subsample = 256;
+  int fast_coarse_subsample = 128;
+  int fast_basin_iterations = 15;
   void Check() const;   // throws std::invalid_argument
 };
 
