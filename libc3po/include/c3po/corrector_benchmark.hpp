@@ -35,7 +35,11 @@ struct CorrectorBenchmarkRow {
   double median_translation_over_d = 0.0, mean_translation_over_d = 0.0;
   double median_adds_over_d = 0.0;
   double percent_oc = 0.0;
+  // Wall-clock per cloud: correction (registration alone: T(ỹ)) + certificates.
   double median_ms = 0.0, mean_ms = 0.0;
+  double median_corrector_ms = 0.0, mean_corrector_ms = 0.0;   // correction only
+  double median_corrector_cpu_ms = 0.0;  // correction only, the thread's CPU time
+  double median_certify_ms = 0.0;        // certificates only
   double mean_iterations = 0.0;
 };
 
