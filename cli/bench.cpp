@@ -29,7 +29,42 @@ struct CorrectorBenchCommand {
   int threads = 1;
   int max_clouds = 0;
   std::string json_path;
+  std::string cases_path;
 };
+
+nlohmann::json PointsJson(const PointSet& points) {
+  nlohmann::json columns = nlohmann::json::array();
+  for (Eigen::Index j = 0; j < points.cols(); ++j) columns.push_back({points(0, j), points(1, j), points(2, j)});
+  return columns;
+}
+
+// JSON lines: a header (model sample B̂, keypoints b, corrector options, the
+// clouds' paths), then one line per case, for reruns by other implementations.
+std::string CasesJsonLines(const ObjectModel& object, const Dataset& dataset,
+                           const CorrectorBenchmarkOptions& options,
+                           const std::vector<CorrectorBenchmarkCase>& cases) {
+  nlohmann::json clouds = nlohmann::json::array();
+  for (std::size_t i = 0; i < dataset.entries.size(); ++i) clouds.push_back(dataset.CloudPath(i));
+  const CorrectorOptions& c = options.corrector;
+  nlohmann::json header = {{"object", object.name()}, {"diameter", object.diameter()},
+                           {"eps_oc", options.certificate.eps_oc}, {"clouds", clouds},
+                           {"model_keypoints", PointsJson(object.keypoints())},
+                           {"model_sample", PointsJson(object.sample())},
+                           {"corrector", {{"kappa", c.kappa}, {"theta", c.theta}, {"loss", ToString(c.loss)},
+                                          {"gd_step", c.gd_step}, {"gd_max_iterations", c.gd_max_iterations},
+                                          {"gd_tolerance", c.gd_tolerance}}}};
+  std::string text = header.dump() + "\n";
+  for (const auto& one : cases) {
+    const nlohmann::json line = {{"sigma", one.sigma}, {"method", one.method}, {"cloud", one.cloud},
+                                 {"detected_keypoints", PointsJson(one.detected_keypoints)},
+                                 {"rotation_deg", one.rotation_deg}, {"oc", one.oc},
+                                 {"iterations", one.iterations}, {"cost_before", one.cost_before},
+                                 {"cost_after", one.cost_after}, {"corrector_ms", one.corrector_ms},
+                                 {"corrector_cpu_ms", one.corrector_cpu_ms}};
+    text += line.dump() + "\n";
+  }
+  return text;
+}
 
 std::vector<double> ParseNumberList(const std::string& text, const std::string& what) {
   std::vector<double> values;
@@ -66,9 +101,10 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
     throw InputError("c3po bench corrector", e.what());
   }
   ProgressBar progress("corrector", 1);
+  std::vector<CorrectorBenchmarkCase> cases;
   const auto rows = RunCorrectorBenchmark(object, dataset, options, [&](std::size_t done, std::size_t total) {
     progress.Update(done * 1000 / std::max<std::size_t>(total, 1) / 1000);
-  });
+  }, cmd.cases_path.empty() ? nullptr : &cases);
   progress.Finish();
   std::printf("corrector analysis: %s, %d clouds, %.0f%% of keypoints perturbed by U[-sigma d/2, sigma d/2], "
               "d = %.4g, eps_oc = %.4g, loss = %s, %d thread(s)\n",
@@ -97,6 +133,7 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
                     {"mean_iterations", row.mean_iterations}});
   }
   if (!cmd.json_path.empty()) WriteFileAtomically(cmd.json_path, json.dump(2) + "\n");
+  if (!cmd.cases_path.empty()) WriteFileAtomically(cmd.cases_path, CasesJsonLines(object, dataset, options, cases));
   return 0;
 }
 
@@ -114,6 +151,9 @@ void SetupCorrectorBench(CLI::App& parent, std::function<int()>* run) {
   sub->add_option("--threads", cmd->threads, "Worker threads (1 gives honest per-cloud times)");
   sub->add_option("--max-clouds", cmd->max_clouds, "Use at most this many clouds (0 = all)");
   sub->add_option("--json", cmd->json_path, "Also write the rows as JSON to this file");
+  sub->add_option("--cases", cmd->cases_path,
+                  "Also write every case (input keypoints, result) and the model sample as JSON lines "
+                  "(input of libc3po/bench/pytorch_corrector_gd.py)");
   sub->footer("Example:\n  c3po bench corrector drill.json --data data/drill_depth --sigma 0.1,0.3,0.5 --solvers fast,gd");
   sub->callback([cmd, run]() { *run = [cmd]() { return RunCorrectorBench(*cmd); }; });
 }

@@ -29,12 +29,7 @@ void CorrectorBenchmarkOptions::Check() const {
 
 namespace {
 
-struct Sample {
-  double rotation_deg, translation_over_d, adds_over_d;
-  double corrector_ms, corrector_cpu_ms, certify_ms;  // registration alone: T(ỹ) only
-  int iterations;
-  bool oc;
-};
+using Sample = CorrectorBenchmarkCase;
 
 double ThreadCpuMilliseconds() {
   timespec now{};
@@ -66,6 +61,8 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
     pose = result.scene_from_model;
     keypoints = result.keypoints;
     out.iterations = result.iterations;
+    out.cost_before = result.cost_before;
+    out.cost_after = result.cost_after;
   } else {
     const RegistrationResult registration = RegisterPoints(object.keypoints(), detected);
     ok = registration.ok() && cloud.cols() > 0;
@@ -127,7 +124,8 @@ CorrectorBenchmarkRow Summarise(double sigma, const std::string& method, const s
 std::vector<CorrectorBenchmarkRow> RunCorrectorBenchmark(const ObjectModel& object,
                                                          const Dataset& dataset,
                                                          const CorrectorBenchmarkOptions& options,
-                                                         const ProgressCallback& progress) {
+                                                         const ProgressCallback& progress,
+                                                         std::vector<CorrectorBenchmarkCase>* cases) {
   options.Check();
   if (!dataset.HasGroundTruth()) throw InputError(dataset.dir, "the corrector benchmark needs ground-truth poses and keypoints");
   std::size_t count = dataset.entries.size();
@@ -158,9 +156,14 @@ std::vector<CorrectorBenchmarkRow> RunCorrectorBenchmark(const ObjectModel& obje
         Rng rng = Rng::ForItem(options.seed + 7919 * s, static_cast<std::uint64_t>(i));
         const PointSet detected = PerturbKeypoints(*entry.keypoints, sigma, options.fraction, d, rng);
         samples[i] = RunOne(object, clouds[i], detected, entry, solver, options);
+        samples[i].sigma = sigma;
+        samples[i].method = method;
+        samples[i].cloud = i;
+        samples[i].detected_keypoints = detected;
         if (progress) progress(++done, total);
       }, options.threads);
       rows.push_back(Summarise(sigma, method, samples));
+      if (cases) cases->insert(cases->end(), samples.begin(), samples.end());
     }
   }
   return rows;

@@ -43,10 +43,26 @@ struct CorrectorBenchmarkRow {
   double mean_iterations = 0.0;
 };
 
-// Requires ground truth (pose + keypoints) in every entry.
+// One cloud of one cell, with its input: lets another implementation rerun
+// the very same cases (libc3po/bench/pytorch_corrector_gd.py).
+struct CorrectorBenchmarkCase {
+  double sigma = 0.0;
+  std::string method;
+  int cloud = 0;                      // dataset entry index
+  PointSet detected_keypoints;        // the perturbed ground truth ỹ
+  double rotation_deg = 0.0, translation_over_d = 0.0, adds_over_d = 0.0;
+  double corrector_ms = 0.0, corrector_cpu_ms = 0.0, certify_ms = 0.0;
+  int iterations = 0;
+  double cost_before = 0.0, cost_after = 0.0;   // f(ỹ), f(y*); 0 for registration alone
+  bool oc = false;
+};
+
+// Requires ground truth (pose + keypoints) in every entry. With `cases`, also
+// appends every cloud's case (rows' order, then cloud order).
 std::vector<CorrectorBenchmarkRow> RunCorrectorBenchmark(const ObjectModel& object,
                                                          const Dataset& dataset,
                                                          const CorrectorBenchmarkOptions& options,
-                                                         const ProgressCallback& progress = {});
+                                                         const ProgressCallback& progress = {},
+                                                         std::vector<CorrectorBenchmarkCase>* cases = nullptr);
 
 }  // namespace c3po
