@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Interrupted training loses nothing (issue 7): `train` killed with SIGINT and
+# Interrupted work loses nothing (issue 7): `train` killed with SIGINT and
 # `selftrain` killed with SIGTERM mid-epoch keep their checkpoint, leave no
 # partial model file, and `--resume` gives the same model bytes as an
-# uninterrupted run with the same seed.
-# Usage: interrupt_resume.sh C3PO_BIN SOURCE_DIR WORK_DIR   (not in ctest yet)
+# uninterrupted run with the same seed. `synth` killed mid-run (SIGINT into a
+# new folder, SIGTERM over an existing dataset) leaves no dataset or the old
+# complete one, and no temporary folder next to it.
+# Usage: interrupt_resume.sh C3PO_BIN SOURCE_DIR WORK_DIR   (ctest: robustness_interrupt_resume)
 set -u
 C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
 rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
@@ -56,6 +58,52 @@ check_resume train cut_train.model ref_train.model "$C3PO" train "$OBJ" "${TRAIN
 echo "reference selftrain: $(grep -c '^epoch' ref_self.err) epochs"
 interrupt selftrain TERM "$C3PO" selftrain "$OBJ" "${SELF[@]}" -o cut_self.model
 check_resume selftrain cut_self.model ref_self.model "$C3PO" selftrain "$OBJ" "${SELF[@]}" -o cut_self.model --resume
+
+# --- synth ------------------------------------------------------------------
+# interrupt_synth NAME SIGNAL DIR: synth into DIR, signalled once its hidden
+# temporary folder holds 20 clouds (mid-run; 4000 are asked for).
+interrupt_synth() {
+  local name=$1 signal=$2 dir=$3 waited=0
+  "$C3PO" synth "$OBJ" -o "$dir" --kind sim --count 4000 --points 400 --seed 5 > "$name.out" 2> "$name.err" &
+  local pid=$!
+  until [ "$(find . -maxdepth 2 -path "./.$dir.partial.*/*.ply" 2>/dev/null | wc -l)" -ge 20 ]; do
+    sleep 0.05; waited=$((waited + 1))
+    if ! kill -0 $pid 2>/dev/null || [ $waited -gt 2000 ]; then break; fi
+  done
+  kill -s "$signal" $pid 2>/dev/null || echo "($name finished before the signal)"
+  wait $pid; local status=$?
+  echo "$name: killed with SIG$signal; status $status; stderr tail: $(tail -1 "$name.err")"
+  # 130 with the message = c3po's cooperative stop; 128 + n alone = killed.
+  [ $status -eq 130 ] && grep -q interrupted "$name.err" \
+    || fail "$name: status $status, not c3po's interrupt status 130 with its message"
+  if ls -A | grep -E "^\.$dir|\.partial|\.tmp"; then fail "$name: temporary files left next to $dir"; fi
+}
+# A dataset is complete when every manifest line names an existing cloud and
+# every cloud is named: prints "complete N" or "incomplete ...".
+dataset_state() {
+  [ -e "$1" ] || { echo "absent"; return; }
+  python3 - "$1" <<'PY'
+import json, os, sys
+d = sys.argv[1]
+try:
+    clouds = [json.loads(l)['cloud'] for l in open(os.path.join(d, 'manifest.jsonl')) if l.strip()]
+except Exception as e:
+    print('incomplete (manifest: %s)' % e); sys.exit()
+files = sorted(f for f in os.listdir(d) if f != 'manifest.jsonl')
+missing = [c for c in clouds if not os.path.isfile(os.path.join(d, c))]
+print('complete %d' % len(clouds) if not missing and sorted(clouds) == files
+      else 'incomplete (%d listed, %d files, %d missing)' % (len(clouds), len(files), len(missing)))
+PY
+}
+interrupt_synth synth_new INT fresh
+state=$(dataset_state fresh); echo "  fresh: $state"
+[ "$state" = absent ] || fail "synth_new: an interrupted synth into a new folder left: $state"
+
+before=$(cd sim && sha256sum -- * | sha256sum)
+interrupt_synth synth_over TERM sim
+state=$(dataset_state sim); echo "  sim: $state"
+[ "$state" = "complete 1500" ] || fail "synth_over: the existing dataset is now: $state"
+[ "$(cd sim && sha256sum -- * | sha256sum)" = "$before" ] || fail "synth_over: the existing dataset changed"
 
 echo "failures: $failures"
 [ $failures -eq 0 ]
