@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, -DC3PO_FUZZ=ON) and runs each for
 # SECONDS, one after another: scripts/fuzz.sh SECONDS [TARGET...]
-# Prints executions per target and any crash/timeout/oom file; exits 1 if a
-# target found one. New corpus entries go to BUILD/fuzz-corpus/<target>
+# Prints executions per target and any crash/timeout/oom/leak file; exits 1
+# if a target found one or did not run cleanly (UB aborts: the fuzz build
+# uses -fno-sanitize-recover=undefined). New corpus entries go to BUILD/fuzz-corpus/<target>
 # (the seeds in tests/fuzz/corpus and tests/fixtures are never modified).
 set -u
 seconds=${1:?usage: scripts/fuzz.sh SECONDS [TARGET...]}
@@ -42,9 +43,14 @@ for t in "${targets[@]}"; do
   ASAN_OPTIONS=$asan "$exe" "$work" "$src/tests/fuzz/corpus/$t" $(seeds_for "$t") "${extra[@]}" \
     -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
     -artifact_prefix="$artifacts/" >"$log" 2>&1
+  code=$?
   runs=$(grep -m1 '^stat::number_of_executed_units' "$log" | awk '{print $2}')
   rate=$(grep -m1 '^stat::average_exec_per_sec' "$log" | awk '{print $2}')
   found=$(ls "$artifacts" 2>/dev/null | tr '\n' ' ')
+  # A finding is an artifact file; a non-zero exit or no statistics (the
+  # fuzzer did not run to its time limit) fails as well.
+  [ $code -ne 0 ] && [ -z "$found" ] && found="exit-status-$code"
+  [ -z "$runs" ] && [ -z "$found" ] && found="no-statistics"
   [ -n "$found" ] && status=1
   printf '%-12s %12s %10s  %s\n' "$t" "${runs:-?}" "${rate:-?}" "${found:-none}"
 done
