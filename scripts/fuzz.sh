@@ -40,7 +40,10 @@ for t in "${targets[@]}"; do
   # (-detect_leaks=0 for libFuzzer, ASAN_OPTIONS for the check at exit).
   extra=(); asan=${ASAN_OPTIONS:-}
   [ "$t" = mesh ] && extra=(-detect_leaks=0) && asan=detect_leaks=0
-  ASAN_OPTIONS=$asan "$exe" "$work" "$src/tests/fuzz/corpus/$t" $(seeds_for "$t") "${extra[@]}" \
+  # Seed folders that exist (git keeps no empty folder in a clean clone).
+  seeds=()
+  for dir in "$src/tests/fuzz/corpus/$t" $(seeds_for "$t"); do [ -d "$dir" ] && seeds+=("$dir"); done
+  ASAN_OPTIONS=$asan "$exe" "$work" "${seeds[@]}" "${extra[@]}" \
     -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
     -artifact_prefix="$artifacts/" >"$log" 2>&1
   code=$?
