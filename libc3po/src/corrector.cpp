@@ -41,6 +41,7 @@ void CorrectorOptions::Check() const {
   require(fast_subsample >= 0, "fast_subsample must be >= 0");
   require(fast_coarse_subsample >= 0, "fast_coarse_subsample must be >= 0");
   require(fast_basin_iterations >= 0, "fast_basin_iterations must be >= 0");
+  require(fast_polish_iterations >= 0, "fast_polish_iterations must be >= 0");
 }
 
 namespace {
@@ -218,7 +219,8 @@ CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, 
   const StageResult fine = RunPointToPlaneStage(object, cloud, FitAtPose(object, cloud, local.best.pose, mean),
                                                 std::min(budget, 5), 1e-4, 1);
   spend(fine);
-  const StageResult polish = RunPointToPointStage(object, cloud, fine.best, mean, 2.0, std::min(budget, 2),
+  const StageResult polish = RunPointToPointStage(object, cloud, fine.best, mean, 2.0,
+                                                  std::min(budget, options.fast_polish_iterations),
                                                   options.fast_tolerance);
   result.iterations = basin.iterations + local.iterations + fine.iterations + polish.iterations;
   result.converged = fine.converged;

@@ -44,7 +44,8 @@ struct CorrectorOptions {
   // fast (mean loss), coarse to fine: (1) at most fast_basin_iterations ICP
   // steps on fast_coarse_subsample points keep the start's basin, (2) damped
   // point-to-plane steps on fast_subsample points, each accepted only if L_pc
-  // decreases, (3) the same on every point, (4) two ICP steps on every point.
+  // decreases, (3) the same on every point, (4) at most fast_polish_iterations
+  // ICP steps on every point.
   // fast_max_iterations bounds the candidate poses evaluated in all stages;
   // the last stage stops when the relative decrease of L_pc < fast_tolerance.
   // 0 subsample = every point.
@@ -53,6 +54,7 @@ struct CorrectorOptions {
   int fast_subsample = 256;
   int fast_coarse_subsample = 128;
   int fast_basin_iterations = 15;
+  int fast_polish_iterations = 2;
   void Check() const;   // throws std::invalid_argument
 };
 
