@@ -203,7 +203,7 @@ CorrectorResult FinishAtPose(const ObjectModel& object, const PoseFit& fit,
 // it, (3) the same on every point, accepted only if L_pc decreases, (4) a
 // couple of ICP steps on every point, the objective itself.
 CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, const Pose& start,
-                              const CorrectorOptions& options, CorrectorResult result) {
+                              double start_loss, const CorrectorOptions& options, CorrectorResult result) {
   const PointSet coarse = StridedSubset(cloud, options.fast_coarse_subsample);
   const PointSet subset = StridedSubset(cloud, options.fast_subsample);
   const PointCloudLoss mean = PointCloudLoss::kMeanSquared;
@@ -224,6 +224,14 @@ CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, 
                                                   options.fast_tolerance);
   result.iterations = basin.iterations + local.iterations + fine.iterations + polish.iterations;
   result.converged = fine.converged;
+  if (polish.best.loss > start_loss) {
+    // The subsets misled the stages: keep T(ỹ), whose y = T·b costs
+    // kappa L_pc(T(ỹ)) <= f(ỹ).
+    PoseFit start_fit;
+    start_fit.pose = start;
+    start_fit.loss = start_loss;
+    return FinishAtPose(object, start_fit, options, result);
+  }
   return FinishAtPose(object, polish.best, options, result);
 }
 
@@ -231,14 +239,16 @@ CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, 
 // continuation towards the max, p = 4, 8, 16, 32; keep the pose with the
 // lowest true max loss (the start included).
 CorrectorResult SolveFastMax(const ObjectModel& object, const PointSet& cloud, const Pose& start,
-                             const CorrectorOptions& options, CorrectorResult result) {
+                             double start_loss, const CorrectorOptions& options, CorrectorResult result) {
   const PointSet subset = StridedSubset(cloud, options.fast_subsample);
   const int budget = options.fast_max_iterations;
   const StageResult mean_stage =
       RunPointToPointStage(object, subset, FitAtPose(object, subset, start, PointCloudLoss::kMeanSquared),
                            PointCloudLoss::kMeanSquared, 2.0, budget / 4, 1e-4);
   int iterations = mean_stage.iterations;
-  PoseFit best = FitAtPose(object, cloud, start, options.loss);
+  PoseFit best;  // only pose and loss are used
+  best.pose = start;
+  best.loss = start_loss;
   PoseFit current = FitAtPose(object, cloud, mean_stage.best.pose, options.loss);
   if (current.loss < best.loss) best = current;
   for (double power : {4.0, 8.0, 16.0, 32.0}) {
@@ -255,9 +265,11 @@ CorrectorResult SolveFastMax(const ObjectModel& object, const PointSet& cloud, c
 }
 
 CorrectorResult SolveFast(const ObjectModel& object, const PointSet& cloud, const Pose& start,
-                          const CorrectorOptions& options, CorrectorResult result) {
-  if (options.loss == PointCloudLoss::kMeanSquared) return SolveFastMean(object, cloud, start, options, result);
-  return SolveFastMax(object, cloud, start, options, result);
+                          double start_loss, const CorrectorOptions& options, CorrectorResult result) {
+  if (options.loss == PointCloudLoss::kMeanSquared) {
+    return SolveFastMean(object, cloud, start, start_loss, options, result);
+  }
+  return SolveFastMax(object, cloud, start, start_loss, options, result);
 }
 
 // The reference solver: Δy <- Δy - step ∇f(ỹ + Δy) from Δy = 0.
@@ -321,7 +333,7 @@ CorrectorResult CorrectKeypoints(const ObjectModel& object, const PointSet& clou
   if (options.solver == CorrectorSolver::kGradientDescent) {
     return SolveGradientDescent(object, cloud, detected_keypoints, options, result);
   }
-  return SolveFast(object, cloud, start.scene_from_model, options, result);
+  return SolveFast(object, cloud, start.scene_from_model, start.point_cloud_loss, options, result);
 }
 
 }  // namespace c3po
