@@ -42,6 +42,8 @@ void CorrectorOptions::Check() const {
   require(fast_coarse_subsample >= 0, "fast_coarse_subsample must be >= 0");
   require(fast_basin_iterations >= 0, "fast_basin_iterations must be >= 0");
   require(fast_polish_iterations >= 0, "fast_polish_iterations must be >= 0");
+  require(std::isfinite(fast_restart_distance), "fast_restart_distance must be finite");
+  require(fast_restart_angle >= 0 && fast_restart_angle <= M_PI, "fast_restart_angle must be in [0, pi]");
 }
 
 namespace {
@@ -198,18 +200,21 @@ CorrectorResult FinishAtPose(const ObjectModel& object, const PoseFit& fit,
   return result;
 }
 
-// Mean loss, coarse to fine: (1) ICP steps on a small subset find the basin of
-// the start, (2) damped point-to-plane steps on a larger subset converge in
-// it, (3) the same on every point, accepted only if L_pc decreases, (4) a
-// couple of ICP steps on every point, the objective itself.
-CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, const Pose& start,
-                              double start_loss, const CorrectorOptions& options, CorrectorResult result) {
-  const PointSet coarse = StridedSubset(cloud, options.fast_coarse_subsample);
-  const PointSet subset = StridedSubset(cloud, options.fast_subsample);
+// Mean loss, coarse to fine, from `start`: (1) ICP steps on a small subset
+// find the basin of the start, (2) damped point-to-plane steps on a larger
+// subset converge in it, (3) the same on every point, accepted only if L_pc
+// decreases, (4) a couple of ICP steps on every point, the objective itself.
+struct Refined {
+  PoseFit fit;  // on every point
+  int iterations = 0;
+  bool converged = false;
+};
+
+Refined RefineMean(const ObjectModel& object, const PointSet& cloud, const PointSet& coarse,
+                   const PointSet& subset, const Pose& start, const CorrectorOptions& options) {
   const PointCloudLoss mean = PointCloudLoss::kMeanSquared;
   int budget = options.fast_max_iterations;
   auto spend = [&budget](const StageResult& stage) { budget = std::max(0, budget - stage.iterations); };
-
   const StageResult basin = RunPointToPointStage(object, coarse, FitAtPose(object, coarse, start, mean),
                                                  mean, 2.0, std::min(budget, options.fast_basin_iterations), 1e-3);
   spend(basin);
@@ -222,9 +227,59 @@ CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, 
   const StageResult polish = RunPointToPointStage(object, cloud, fine.best, mean, 2.0,
                                                   std::min(budget, options.fast_polish_iterations),
                                                   options.fast_tolerance);
-  result.iterations = basin.iterations + local.iterations + fine.iterations + polish.iterations;
-  result.converged = fine.converged;
-  if (polish.best.loss > start_loss) {
+  return {polish.best, basin.iterations + local.iterations + fine.iterations + polish.iterations,
+          fine.converged};
+}
+
+// Further starts when the fit leaves an input point farther than the restart
+// distance from the posed model (a wrong basin, typically a turned pose): the
+// found pose turned by ±fast_restart_angle about the three axes through the
+// cloud's centroid. Each is screened by the basin stage on the coarse subset;
+// the best one, if it fits the coarse subset better, is refined, and kept if
+// its L_pc is lower. The same objective, minimised better.
+Refined TryRestarts(const ObjectModel& object, const PointSet& cloud, const PointSet& coarse,
+                    const PointSet& subset, Refined found, const CorrectorOptions& options) {
+  const PointCloudLoss mean = PointCloudLoss::kMeanSquared;
+  const Eigen::Vector3d centre = cloud.rowwise().mean();
+  PoseFit best_screen = FitAtPose(object, coarse, found.fit.pose, mean);
+  const double found_screen = best_screen.loss;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double sign : {-1.0, 1.0}) {
+      const Eigen::Matrix3d turn(Eigen::AngleAxisd(sign * options.fast_restart_angle, Eigen::Vector3d::Unit(axis)));
+      Pose hypothesis;
+      hypothesis.R = turn * found.fit.pose.R;
+      hypothesis.t = turn * (found.fit.pose.t - centre) + centre;
+      const StageResult screen =
+          RunPointToPointStage(object, coarse, FitAtPose(object, coarse, hypothesis, mean), mean, 2.0,
+                               options.fast_basin_iterations, 1e-3);
+      found.iterations += screen.iterations + 1;
+      if (screen.best.loss < best_screen.loss) best_screen = screen.best;
+    }
+  }
+  if (!(best_screen.loss < found_screen)) return found;
+  const Refined other = RefineMean(object, cloud, coarse, subset, best_screen.pose, options);
+  found.iterations += other.iterations;
+  if (other.fit.loss < found.fit.loss) {
+    found.fit = other.fit;
+    found.converged = other.converged;
+  }
+  return found;
+}
+
+CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, const Pose& start,
+                              double start_loss, const CorrectorOptions& options, CorrectorResult result) {
+  const PointSet coarse = StridedSubset(cloud, options.fast_coarse_subsample);
+  const PointSet subset = StridedSubset(cloud, options.fast_subsample);
+  Refined refined = RefineMean(object, cloud, coarse, subset, start, options);
+  const double restart_distance =
+      options.fast_restart_distance < 0 ? object.spec().eps_oc : options.fast_restart_distance;
+  if (restart_distance > 0 && options.fast_restart_angle > 0 &&
+      refined.fit.squared.maxCoeff() >= restart_distance * restart_distance) {
+    refined = TryRestarts(object, cloud, coarse, subset, refined, options);
+  }
+  result.iterations = refined.iterations;
+  result.converged = refined.converged;
+  if (refined.fit.loss > start_loss) {
     // The subsets misled the stages: keep T(ỹ), whose y = T·b costs
     // kappa L_pc(T(ỹ)) <= f(ỹ).
     PoseFit start_fit;
@@ -232,7 +287,7 @@ CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, 
     start_fit.loss = start_loss;
     return FinishAtPose(object, start_fit, options, result);
   }
-  return FinishAtPose(object, polish.best, options, result);
+  return FinishAtPose(object, refined.fit, options, result);
 }
 
 // Max loss: ICP on a subset (mean loss) finds the basin, then an IRLS

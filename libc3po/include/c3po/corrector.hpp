@@ -55,6 +55,12 @@ struct CorrectorOptions {
   int fast_coarse_subsample = 128;
   int fast_basin_iterations = 15;
   int fast_polish_iterations = 2;
+  // fast (mean loss): when the result leaves an input point at least
+  // fast_restart_distance from the posed model (-1 = the object's eps_oc,
+  // 0 = never), also try the result turned by ±fast_restart_angle (radians)
+  // about three axes, and keep the lowest L_pc.
+  double fast_restart_distance = -1.0;
+  double fast_restart_angle = 0.8;
   void Check() const;   // throws std::invalid_argument
 };
 
