@@ -1,7 +1,8 @@
 // The fast corrector must stay in the basin of its start: on partial (depth)
 // views with large keypoint perturbations, it reaches the ground truth
 // whenever the reference's small-step gradient descent does. (An undamped
-// point-to-plane Gauss-Newton start jumped to wrong minima on some of these.)
+// point-to-plane Gauss-Newton start jumped to wrong minima on some of these;
+// the restarts also solve one that gd does not.)
 #include <doctest/doctest.h>
 
 #include "c3po/corrector.hpp"
@@ -38,9 +39,10 @@ TEST_CASE("fast corrector reaches the ground truth whenever gd does (depth views
   synth.seed = 7;
   const SynthGenerator generator(object.mesh(), object.keypoints(), synth, "asymmetric object");
   const auto renderer = generator.MakeRenderer();
-  CorrectorOptions fast, gd;
+  CorrectorOptions fast, gd, no_restarts;
   gd.solver = CorrectorSolver::kGradientDescent;
-  int hard_starts = 0, gd_reached = 0;
+  no_restarts.fast_restart_distance = 0.0;
+  int hard_starts = 0, gd_reached = 0, fast_reached = 0, restarts_helped = 0;
   for (int i = 0; i < synth.count; ++i) {
     const SynthSample sample = generator.Generate(i, renderer.get());
     const PointSet& detected = *sample.detected_keypoints;
@@ -52,6 +54,11 @@ TEST_CASE("fast corrector reaches the ground truth whenever gd does (depth views
     REQUIRE(by_gd.ok());
     REQUIRE(by_fast.ok());
     CHECK(by_fast.cost_after < by_fast.cost_before);
+    // Restarts only ever keep a lower L_pc.
+    const CorrectorResult without = CorrectKeypoints(object, sample.cloud, detected, no_restarts);
+    CHECK(by_fast.cost_after <= without.cost_after);
+    if (by_fast.cost_after < 0.5 * without.cost_after) ++restarts_helped;
+    if (Compare(by_fast.scene_from_model, sample.scene_from_model, d).reached_truth()) ++fast_reached;
     if (!Compare(by_gd.scene_from_model, sample.scene_from_model, d).reached_truth()) continue;
     ++gd_reached;
     const Outcome outcome = Compare(by_fast.scene_from_model, sample.scene_from_model, d);
@@ -64,4 +71,6 @@ TEST_CASE("fast corrector reaches the ground truth whenever gd does (depth views
   // The cases are hard (far starts) and mostly solvable by gd.
   CHECK(hard_starts >= 5);
   CHECK(gd_reached >= 15);
+  CHECK(fast_reached >= gd_reached);
+  CHECK(restarts_helped >= 1);
 }
