@@ -56,6 +56,8 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
   if (solver) {
     CorrectorOptions corrector = options.corrector;
     corrector.solver = *solver;
+    // Restarts follow the threshold certified here (as in the pipeline).
+    if (corrector.fast_restart_distance < 0) corrector.fast_restart_distance = options.certificate.eps_oc;
     const CorrectorResult result = CorrectKeypoints(object, cloud, detected, corrector);
     ok = result.ok();
     pose = result.scene_from_model;

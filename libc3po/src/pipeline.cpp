@@ -35,7 +35,13 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
   estimate.detected_keypoints = detected_keypoints;
   const PointSet corrector_cloud = StridedColumns(cloud, options.max_corrector_points);
   if (options.correct) {
-    estimate.correction = CorrectKeypoints(object, corrector_cloud, detected_keypoints, options.corrector);
+    // The fast solver's restarts are triggered by the threshold actually
+    // certified (a --eps-oc override), not only the object file's.
+    CorrectorOptions corrector = options.corrector;
+    if (corrector.fast_restart_distance < 0 && options.certificate.eps_oc > 0) {
+      corrector.fast_restart_distance = options.certificate.eps_oc;
+    }
+    estimate.correction = CorrectKeypoints(object, corrector_cloud, detected_keypoints, corrector);
   } else {
     // Registration only: y* = ỹ, T̂ = T(ỹ).
     CorrectorOptions no_iterations = options.corrector;
