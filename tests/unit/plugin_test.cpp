@@ -55,7 +55,8 @@ TEST_CASE("a plugin loaded before first registry use may replace a built-in dete
   const auto detector = CreateDetector("svd", object);
   const PointSet cloud = SampleSurface(object.mesh(), 200, 3);
   CHECK(detector->Detect(cloud).isApprox(CentroidOracle(object.keypoints(), cloud), 1e-12));
-  const DetectorInfo* info = FindInfo(ListDetectors(), "svd");
+  const std::vector<DetectorInfo> infos = ListDetectors();   // outlives `info`
+  const DetectorInfo* info = FindInfo(infos, "svd");
   REQUIRE(info != nullptr);
   CHECK(Contains(info->description, C3PO_TEST_PLUGIN_NAMED_SVD));
 
@@ -92,7 +93,8 @@ TEST_CASE("unknown detector names are an InputError listing the known ones") {
 
 TEST_CASE("LoadPlugin loads the centroid test plugin and its detector works") {
   LoadPlugin(C3PO_TEST_PLUGIN);
-  const DetectorInfo* info = FindInfo(ListDetectors(), "centroid");
+  const std::vector<DetectorInfo> infos = ListDetectors();   // outlives `info`
+  const DetectorInfo* info = FindInfo(infos, "centroid");
   REQUIRE(info != nullptr);
   CHECK_FALSE(info->needs_model_file);
   CHECK(Contains(info->description, C3PO_TEST_PLUGIN));
