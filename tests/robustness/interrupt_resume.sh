@@ -13,9 +13,17 @@ OBJ="$SRC/tests/fixtures/objects/cube.json"
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 
-"$C3PO" synth "$OBJ" -o sim --kind sim --count 1500 --points 400 --seed 1 >/dev/null 2>&1 || { echo "synth failed"; exit 2; }
-"$C3PO" synth "$OBJ" -o unlabelled --kind sim --count 800 --points 400 --noise 1%d --seed 2 >/dev/null 2>&1 || exit 2
-TRAIN=(--data sim --epochs 4 --point-mlp 128 256 --head 256 --points 1024 --seed 7)
+# Epochs must last long enough (~0.7 s here) for the signal to land inside
+# epoch 2. Sanitizer builds train ~35x slower: C3PO_ROBUSTNESS_LIGHT=1 (set by
+# scripts/sanitize.sh) uses a smaller run whose epochs take ~2 s there.
+if [ "${C3PO_ROBUSTNESS_LIGHT:-0}" = 1 ]; then
+  SIM=(--count 300 --points 400); UNLABELLED=(--count 160 --points 400); NET=(--point-mlp 64 128 --head 128 --points 512)
+else
+  SIM=(--count 1500 --points 400); UNLABELLED=(--count 800 --points 400); NET=(--point-mlp 128 256 --head 256 --points 1024)
+fi
+"$C3PO" synth "$OBJ" -o sim --kind sim "${SIM[@]}" --seed 1 >/dev/null 2>&1 || { echo "synth failed"; exit 2; }
+"$C3PO" synth "$OBJ" -o unlabelled --kind sim "${UNLABELLED[@]}" --noise 1%d --seed 2 >/dev/null 2>&1 || exit 2
+TRAIN=(--data sim --epochs 4 "${NET[@]}" --seed 7)
 SELF=(--model ref_train.model --data unlabelled --epochs 4 --seed 9)
 
 # interrupt NAME SIGNAL CMD...: starts CMD, sends SIGNAL once the first epoch
@@ -102,7 +110,7 @@ state=$(dataset_state fresh); echo "  fresh: $state"
 before=$(cd sim && sha256sum -- * | sha256sum)
 interrupt_synth synth_over TERM sim
 state=$(dataset_state sim); echo "  sim: $state"
-[ "$state" = "complete 1500" ] || fail "synth_over: the existing dataset is now: $state"
+[ "$state" = "complete ${SIM[1]}" ] || fail "synth_over: the existing dataset is now: $state"
 [ "$(cd sim && sha256sum -- * | sha256sum)" = "$before" ] || fail "synth_over: the existing dataset changed"
 
 echo "failures: $failures"
