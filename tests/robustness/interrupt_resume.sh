@@ -13,13 +13,13 @@ OBJ="$SRC/tests/fixtures/objects/cube.json"
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 
-# Epochs must last long enough (~0.7 s here) for the signal to land inside
+# Epochs must last long enough (train ~0.7 s, selftrain ~2 s) for the signal to land inside
 # epoch 2. Sanitizer builds train ~35x slower: C3PO_ROBUSTNESS_LIGHT=1 (set by
 # scripts/sanitize.sh) uses a smaller run whose epochs take ~2 s there.
 if [ "${C3PO_ROBUSTNESS_LIGHT:-0}" = 1 ]; then
   SIM=(--count 300 --points 400); UNLABELLED=(--count 160 --points 400); NET=(--point-mlp 64 128 --head 128 --points 512)
 else
-  SIM=(--count 1500 --points 400); UNLABELLED=(--count 800 --points 400); NET=(--point-mlp 128 256 --head 256 --points 1024)
+  SIM=(--count 1500 --points 400); UNLABELLED=(--count 200 --points 400); NET=(--point-mlp 128 256 --head 256 --points 1024)
 fi
 "$C3PO" synth "$OBJ" -o sim --kind sim "${SIM[@]}" --seed 1 >/dev/null 2>&1 || { echo "synth failed"; exit 2; }
 "$C3PO" synth "$OBJ" -o unlabelled --kind sim "${UNLABELLED[@]}" --noise 1%d --seed 2 >/dev/null 2>&1 || exit 2
