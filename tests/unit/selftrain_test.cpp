@@ -108,11 +108,21 @@ TEST_CASE("self-training raises the certified fraction of a biased detector") {
 
 TEST_CASE("self-training with nothing certified stops with a clear message") {
   const ObjectModel object = test::AsymmetricObject(4000);
-  const auto clouds = Clouds(object, 12);
-  // Keypoints 0.5 m away from the clouds: nothing can be observably correct.
-  OffsetDetector detector(CentredKeypoints(object).colwise() + Eigen::Vector3d(0.5, 0.5, 0.5), 0.1);
+  // Clouds spread uniformly through a 2 m cube, over five times the object's size:
+  // no pose of the object lies within eps_oc of every point, so nothing can
+  // be observably correct whatever the detector and the corrector do.
+  std::vector<PointSet> clouds;
+  Rng rng(9);
+  for (int i = 0; i < 12; ++i) {
+    PointSet cloud(3, 300);
+    for (Eigen::Index j = 0; j < cloud.cols(); ++j) {
+      cloud.col(j) = Eigen::Vector3d(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(1, 3));
+    }
+    clouds.push_back(cloud);
+  }
+  REQUIRE(object.diameter() < 2.0 / 5);
+  OffsetDetector detector(CentredKeypoints(object), 0.1);
   SelfTrainOptions options = Options(object);
-  options.pipeline.corrector.fast_max_iterations = 3;
   CHECK_THROWS_WITH_AS(SelfTrain(object, clouds, detector, options),
                        doctest::Contains("nothing to learn from"), InputError);
 }
