@@ -48,15 +48,6 @@ void CorrectorOptions::Check() const {
 
 namespace {
 
-// Every k-th column, so the subset is deterministic and spread over the cloud.
-PointSet StridedSubset(const PointSet& cloud, int max_points) {
-  if (max_points <= 0 || cloud.cols() <= max_points) return cloud;
-  PointSet subset(3, max_points);
-  const double stride = static_cast<double>(cloud.cols()) / max_points;
-  for (int i = 0; i < max_points; ++i) subset.col(i) = cloud.col(static_cast<Eigen::Index>(i * stride));
-  return subset;
-}
-
 // L_pc of `points` at `pose`, with the nearest B̂ point of every input point.
 struct PoseFit {
   Pose pose;
@@ -268,8 +259,8 @@ Refined TryRestarts(const ObjectModel& object, const PointSet& cloud, const Poin
 
 CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, const Pose& start,
                               double start_loss, const CorrectorOptions& options, CorrectorResult result) {
-  const PointSet coarse = StridedSubset(cloud, options.fast_coarse_subsample);
-  const PointSet subset = StridedSubset(cloud, options.fast_subsample);
+  const PointSet coarse = StridedColumns(cloud, options.fast_coarse_subsample);
+  const PointSet subset = StridedColumns(cloud, options.fast_subsample);
   Refined refined = RefineMean(object, cloud, coarse, subset, start, options);
   const double restart_distance =
       options.fast_restart_distance < 0 ? object.spec().eps_oc : options.fast_restart_distance;
@@ -295,7 +286,7 @@ CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, 
 // lowest true max loss (the start included).
 CorrectorResult SolveFastMax(const ObjectModel& object, const PointSet& cloud, const Pose& start,
                              double start_loss, const CorrectorOptions& options, CorrectorResult result) {
-  const PointSet subset = StridedSubset(cloud, options.fast_subsample);
+  const PointSet subset = StridedColumns(cloud, options.fast_subsample);
   const int budget = options.fast_max_iterations;
   const StageResult mean_stage =
       RunPointToPointStage(object, subset, FitAtPose(object, subset, start, PointCloudLoss::kMeanSquared),

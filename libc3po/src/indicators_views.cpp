@@ -37,14 +37,6 @@ Eigen::Matrix3d LookAtRotation(const Eigen::Vector3d& direction, double roll) {
   return model_from_camera.transpose();
 }
 
-// Evenly strided columns (all when count >= cols).
-PointSet Subsample(const PointSet& points, int count) {
-  if (count <= 0 || points.cols() <= count) return points;
-  PointSet out(3, count);
-  for (int i = 0; i < count; ++i) out.col(i) = points.col(static_cast<Eigen::Index>(i) * points.cols() / count);
-  return out;
-}
-
 // Hausdorff(T1·B̂, T2·B̂) = Hausdorff(B̂, T·B̂), T = T1^-1 T2, with a subsample
 // Q of B̂ as queries and the model tree as targets (no rebuild).
 double PosedModelHausdorff(const ObjectModel& object, const PointSet& queries, const Pose& first,
@@ -185,14 +177,14 @@ ViewDegeneracy AnalyzeViewDegeneracy(const ObjectModel& object, const PointSet& 
   std::vector<Pose> starts;
   for (const Pose& motion : motions) starts.push_back(scene_from_model * motion);
   const Eigen::Vector3d ray = cloud.rowwise().mean().normalized();
-  const Eigen::VectorXd depth = ray.transpose() * (scene_from_model * Subsample(object.sample(), 2000));
+  const Eigen::VectorXd depth = ray.transpose() * (scene_from_model * StridedColumns(object.sample(), 2000));
   const double extent = depth.maxCoeff() - depth.minCoeff();
   for (double fraction : {-1.0, -0.5, 0.5, 1.0}) {
     starts.push_back(Pose{Eigen::Matrix3d::Identity(), fraction * extent * ray} * scene_from_model);
   }
 
-  const PointSet search_cloud = Subsample(cloud, options.search_points);
-  const PointSet queries = Subsample(object.sample(), options.hausdorff_points);
+  const PointSet search_cloud = StridedColumns(cloud, options.search_points);
+  const PointSet queries = StridedColumns(object.sample(), options.hausdorff_points);
   const double tolerance = options.tolerance_factor * options.eps_oc;
   IcpOptions screening = options.icp;
   screening.max_iterations = std::min(options.icp.max_iterations, options.screening_iterations);

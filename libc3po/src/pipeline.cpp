@@ -7,20 +7,6 @@
 
 namespace c3po {
 
-namespace {
-
-// Columns floor(j n / k), j = 0..k-1, k = min(n, limit); the cloud itself
-// when it has at most `limit` columns or limit is 0.
-PointSet StridedColumns(const PointSet& cloud, int limit) {
-  const Eigen::Index n = cloud.cols();
-  if (limit <= 0 || n <= limit) return cloud;
-  PointSet subset(3, limit);
-  for (Eigen::Index j = 0; j < limit; ++j) subset.col(j) = cloud.col(j * n / limit);
-  return subset;
-}
-
-}  // namespace
-
 void PipelineOptions::Check() const {
   if (max_corrector_points < 0) throw std::invalid_argument("max_corrector_points must be >= 0");
   corrector.Check();

@@ -115,3 +115,24 @@ TEST_CASE("pipeline: the corrector sees a strided subset, the certificate every 
   CHECK(dirty.certificate.oc.max_point_distance == doctest::Approx(brute));
   CHECK(dirty.certificate.oc.point_distances.size() == cloud.cols());
 }
+
+TEST_CASE("StridedColumns keeps min(n, limit) columns, in order, evenly spread from the first") {
+  for (const Eigen::Index n : {0, 1, 7, 1000, 1001, 99991}) {
+    PointSet points(3, n);
+    for (Eigen::Index i = 0; i < n; ++i) points.col(i) = Eigen::Vector3d(static_cast<double>(i), 0, 0);
+    for (const Eigen::Index limit : {0, 1, 5, 128, 256, 1000, 20000}) {
+      const PointSet kept = StridedColumns(points, limit);
+      const Eigen::Index expected = (limit <= 0 || n <= limit) ? n : limit;
+      REQUIRE(kept.cols() == expected);
+      if (expected == 0) continue;
+      CHECK(kept(0, 0) == 0.0);
+      // Gaps between kept column indices are floor or ceil of n / k.
+      const double mean_gap = static_cast<double>(n) / static_cast<double>(expected);
+      for (Eigen::Index j = 1; j < expected; ++j) {
+        const double gap = kept(0, j) - kept(0, j - 1);
+        CHECK(gap >= std::floor(mean_gap));
+        CHECK(gap <= std::ceil(mean_gap));
+      }
+    }
+  }
+}

@@ -29,4 +29,16 @@ struct Pose {
   bool IsFinite() const { return R.allFinite() && t.allFinite(); }
 };
 
+// At most `limit` columns, evenly strided: columns floor(j n / k),
+// j = 0..k-1, k = min(n, limit); every column when limit <= 0 or n <= limit.
+// Deterministic and spread over the whole set (clouds are stored in scan
+// or sampling order).
+inline PointSet StridedColumns(const PointSet& points, Eigen::Index limit) {
+  const Eigen::Index n = points.cols();
+  if (limit <= 0 || n <= limit) return points;
+  PointSet subset(3, limit);
+  for (Eigen::Index j = 0; j < limit; ++j) subset.col(j) = points.col(j * n / limit);
+  return subset;
+}
+
 }  // namespace c3po
