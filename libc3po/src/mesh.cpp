@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -95,6 +96,40 @@ Eigen::AlignedBox3d Mesh::BoundingBox() const {
   return box;
 }
 
+namespace {
+
+// assimp's OFF importer allocates the header's vertex and face counts before
+// reading them (a fuzzed header claiming 8.9e9 faces asked for 48 GB). An
+// ASCII OFF file needs at least 5 bytes per vertex ("0 0 0") and 1 per face,
+// so counts the file cannot hold are rejected before assimp sees the file.
+void CheckOffHeaderAgainstFileSize(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string keyword;
+  if (!(in >> keyword) || keyword.size() < 3 || keyword.compare(keyword.size() - 3, 3, "OFF") != 0) return;
+  std::string token;
+  std::vector<double> counts;
+  while (counts.size() < 2 && in >> token) {
+    if (token[0] == '#') {
+      std::getline(in, token);
+      continue;
+    }
+    char* end = nullptr;
+    const double value = std::strtod(token.c_str(), &end);
+    if (end == token.c_str()) return;   // not a count: leave the error to assimp
+    counts.push_back(value);
+  }
+  if (counts.size() < 2) return;
+  const double bytes = static_cast<double>(std::filesystem::file_size(path));
+  if (!(counts[0] >= 0 && counts[1] >= 0 && 5.0 * counts[0] + counts[1] <= bytes)) {
+    std::ostringstream message;
+    message << "OFF header claims " << counts[0] << " vertices and " << counts[1]
+            << " faces, more than the file's " << bytes << " bytes can hold";
+    throw InputError(path, message.str());
+  }
+}
+
+}  // namespace
+
 void Mesh::Validate() const {
   if (!vertices.allFinite()) throw std::invalid_argument("mesh has non-finite vertices");
   if (triangles.size() > 0 &&
@@ -105,6 +140,7 @@ void Mesh::Validate() const {
 
 Mesh LoadMesh(const std::string& path, double scale) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path, "mesh file not found");
+  CheckOffHeaderAgainstFileSize(path);
   Assimp::Importer importer;
   // No normals, no materials: only triangulated geometry with merged vertices.
   const aiScene* scene = importer.ReadFile(

@@ -211,6 +211,17 @@ TEST_CASE("bad mesh files give an InputError naming the file") {
 
   WriteText(dir / "empty.obj", "");
   CheckLoadFails(dir / "empty.obj");
+  // Counts the file cannot hold are rejected before assimp allocates them
+  // (the fuzzer's OFF header claiming 8.9e9 faces asked for 48 GB).
+  const std::string cube_off_body =
+      "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n"
+      "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n";
+  WriteText(dir / "huge_faces.off", "OFF\n8 8888888886 0\n" + cube_off_body);
+  CheckLoadFails(dir / "huge_faces.off");
+  WriteText(dir / "huge_vertices.off", "OFF\n# comment\n900000000000 6 0\n" + cube_off_body);
+  CheckLoadFails(dir / "huge_vertices.off");
+  WriteText(dir / "cube.off", "OFF\n8 6 0\n" + cube_off_body);
+  CHECK(c3po::LoadMesh(dir / "cube.off").triangles.cols() == 12);
   WriteText(dir / "empty.ply", "");
   CheckLoadFails(dir / "empty.ply");
   WriteText(dir / "only_vertices.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
