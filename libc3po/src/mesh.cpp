@@ -1,20 +1,14 @@
+// Mesh geometry: area, bounding box, surface sampling, closest points, OBJ
+// output. Loading is in mesh_load.cpp.
 #include "c3po/mesh.hpp"
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-
 #include <algorithm>
-#include <assimp/Importer.hpp>
-#include <filesystem>
-#include <fstream>
-#include <iomanip>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 #include "c3po/atomic_file.hpp"
-#include "c3po/error.hpp"
 #include "c3po/random.hpp"
+#include "cloud_io_internal.hpp"
 
 namespace c3po {
 namespace {
@@ -26,42 +20,6 @@ Eigen::Vector3d Corner(const Mesh& mesh, int triangle, int k) {
 double TriangleArea(const Mesh& mesh, int t) {
   const Eigen::Vector3d a = Corner(mesh, t, 0), b = Corner(mesh, t, 1), c = Corner(mesh, t, 2);
   return 0.5 * (b - a).cross(c - a).norm();
-}
-
-// Appends one assimp mesh (triangles only; points and lines are skipped).
-void AppendAssimpMesh(const aiMesh& source, const aiMatrix4x4& to_root, double scale,
-                      std::vector<Eigen::Vector3d>* vertices,
-                      std::vector<Eigen::Vector3i>* triangles) {
-  // Point and line meshes (split off by aiProcess_SortByPType) must not add
-  // their vertices: they would enlarge the bounding box and the diameter.
-  if ((source.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) return;
-  const int offset = static_cast<int>(vertices->size());
-  for (unsigned i = 0; i < source.mNumVertices; ++i) {
-    const aiVector3D v = to_root * source.mVertices[i];
-    vertices->emplace_back(scale * v.x, scale * v.y, scale * v.z);
-  }
-  for (unsigned f = 0; f < source.mNumFaces; ++f) {
-    const aiFace& face = source.mFaces[f];
-    if (face.mNumIndices != 3) continue;
-    triangles->emplace_back(offset + static_cast<int>(face.mIndices[0]),
-                            offset + static_cast<int>(face.mIndices[1]),
-                            offset + static_cast<int>(face.mIndices[2]));
-  }
-}
-
-void CollectNode(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent,
-                 double scale, std::vector<Eigen::Vector3d>* vertices,
-                 std::vector<Eigen::Vector3i>* triangles, int depth) {
-  if (depth > 64) return;  // pathological node nesting
-  const aiMatrix4x4 to_root = parent * node.mTransformation;
-  for (unsigned m = 0; m < node.mNumMeshes; ++m) {
-    if (node.mMeshes[m] < scene.mNumMeshes) {
-      AppendAssimpMesh(*scene.mMeshes[node.mMeshes[m]], to_root, scale, vertices, triangles);
-    }
-  }
-  for (unsigned c = 0; c < node.mNumChildren; ++c) {
-    CollectNode(scene, *node.mChildren[c], to_root, scale, vertices, triangles, depth + 1);
-  }
 }
 
 Eigen::Vector3d ClosestPointOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
@@ -96,40 +54,6 @@ Eigen::AlignedBox3d Mesh::BoundingBox() const {
   return box;
 }
 
-namespace {
-
-// assimp's OFF importer allocates the header's vertex and face counts before
-// reading them (a fuzzed header claiming 8.9e9 faces asked for 48 GB). An
-// ASCII OFF file needs at least 5 bytes per vertex ("0 0 0") and 1 per face,
-// so counts the file cannot hold are rejected before assimp sees the file.
-void CheckOffHeaderAgainstFileSize(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string keyword;
-  if (!(in >> keyword) || keyword.size() < 3 || keyword.compare(keyword.size() - 3, 3, "OFF") != 0) return;
-  std::string token;
-  std::vector<double> counts;
-  while (counts.size() < 2 && in >> token) {
-    if (token[0] == '#') {
-      std::getline(in, token);
-      continue;
-    }
-    char* end = nullptr;
-    const double value = std::strtod(token.c_str(), &end);
-    if (end == token.c_str()) return;   // not a count: leave the error to assimp
-    counts.push_back(value);
-  }
-  if (counts.size() < 2) return;
-  const double bytes = static_cast<double>(std::filesystem::file_size(path));
-  if (!(counts[0] >= 0 && counts[1] >= 0 && 5.0 * counts[0] + counts[1] <= bytes)) {
-    std::ostringstream message;
-    message << "OFF header claims " << counts[0] << " vertices and " << counts[1]
-            << " faces, more than the file's " << bytes << " bytes can hold";
-    throw InputError(path, message.str());
-  }
-}
-
-}  // namespace
-
 void Mesh::Validate() const {
   if (!vertices.allFinite()) throw std::invalid_argument("mesh has non-finite vertices");
   if (triangles.size() > 0 &&
@@ -138,39 +62,15 @@ void Mesh::Validate() const {
   }
 }
 
-Mesh LoadMesh(const std::string& path, double scale) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "mesh file not found");
-  CheckOffHeaderAgainstFileSize(path);
-  Assimp::Importer importer;
-  // No normals, no materials: only triangulated geometry with merged vertices.
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                aiProcess_SortByPType | aiProcess_ValidateDataStructure);
-  if (scene == nullptr || scene->mRootNode == nullptr) {
-    std::string reason = importer.GetErrorString();
-    std::replace(reason.begin(), reason.end(), '\n', ' ');
-    throw InputError(path, "cannot read mesh: " + (reason.empty() ? "unknown format" : reason));
-  }
-  std::vector<Eigen::Vector3d> vertices;
-  std::vector<Eigen::Vector3i> triangles;
-  CollectNode(*scene, *scene->mRootNode, aiMatrix4x4(), scale, &vertices, &triangles, 0);
-  if (triangles.empty()) throw InputError(path, "mesh has no triangles");
-  Mesh mesh;
-  mesh.vertices.resize(3, static_cast<Eigen::Index>(vertices.size()));
-  for (std::size_t i = 0; i < vertices.size(); ++i) mesh.vertices.col(i) = vertices[i];
-  mesh.triangles.resize(3, static_cast<Eigen::Index>(triangles.size()));
-  for (std::size_t i = 0; i < triangles.size(); ++i) mesh.triangles.col(i) = triangles[i];
-  if (!mesh.vertices.allFinite()) throw InputError(path, "mesh has non-finite vertex coordinates");
-  if (!(mesh.SurfaceArea() > 0.0)) throw InputError(path, "mesh has zero surface area");
-  return mesh;
-}
-
 void WriteObj(const Mesh& mesh, const std::string& path) {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "# written by c3po\n" << std::setprecision(9);
+    // Shortest text that reads back to the same double: LoadMesh returns
+    // exactly the mesh that was written.
+    out << "# written by c3po\n";
     for (int i = 0; i < mesh.vertices.cols(); ++i) {
-      out << "v " << mesh.vertices(0, i) << ' ' << mesh.vertices(1, i) << ' '
-          << mesh.vertices(2, i) << '\n';
+      out << "v " << cloud_detail::FormatDouble(mesh.vertices(0, i)) << ' '
+          << cloud_detail::FormatDouble(mesh.vertices(1, i)) << ' '
+          << cloud_detail::FormatDouble(mesh.vertices(2, i)) << '\n';
     }
     for (int t = 0; t < mesh.triangles.cols(); ++t) {
       out << "f " << mesh.triangles(0, t) + 1 << ' ' << mesh.triangles(1, t) + 1 << ' '

@@ -1,8 +1,11 @@
-// PLY point clouds: reader (ASCII, binary little/big endian, any scalar types,
-// any elements around `vertex`, list properties skipped) and writers.
+// PLY point clouds and meshes: reader (ASCII, binary little/big endian, any
+// scalar types, any elements around `vertex`; list properties skipped, except
+// a mesh's face `vertex_indices`, fan-triangulated) and writers.
 //
 // Every count in the header is checked against the bytes actually present
 // before anything is allocated, so a header that lies cannot exhaust memory.
+// LoadMesh reads .ply meshes here rather than with assimp, whose PLY importer
+// aborts the process on some malformed headers (found by fuzz_mesh).
 #include <algorithm>
 #include <optional>
 
@@ -10,10 +13,13 @@
 #include "c3po/cloud_io.hpp"
 #include "c3po/error.hpp"
 #include "cloud_io_internal.hpp"
+#include "mesh_io_internal.hpp"
 
 namespace c3po {
 namespace cloud_detail {
 namespace {
+
+using mesh_detail::TriangleCollector;
 
 enum class PlyEncoding { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
 
@@ -52,6 +58,14 @@ struct PlyHeader {
   int xyz[3] = {-1, -1, -1};   // property indices of x, y, z in the vertex element
   std::size_t data_offset = 0;
   std::size_t data_first_line = 0;
+  // Meshes only: the face element and its vertex-index list property.
+  std::optional<std::size_t> face_element;
+  std::size_t face_indices = 0;
+
+  bool IsFaceIndices(std::size_t element, std::size_t property) const {
+    return face_element && *face_element == element && face_indices == property;
+  }
+  std::uint64_t VertexCount() const { return elements[vertex_element].count; }
 };
 
 std::optional<Scalar> PlyScalarType(std::string_view name) {
@@ -174,6 +188,28 @@ class PlyHeaderParser {
   PlyHeader header_;
 };
 
+// Marks the `face` element's `vertex_indices` (or `vertex_index`) list.
+void FindFaceIndices(PlyHeader* header, const std::string& name) {
+  const auto& elements = header->elements;
+  const auto face = std::find_if(elements.begin(), elements.end(),
+                                 [](const PlyElement& e) { return e.name == "face"; });
+  if (face == elements.end()) throw InputError(name, "no face element in the PLY header (a point cloud, not a mesh)");
+  const auto& properties = face->properties;
+  const auto indices = std::find_if(properties.begin(), properties.end(), [](const PlyProperty& p) {
+    return p.name == "vertex_indices" || p.name == "vertex_index";
+  });
+  if (indices == properties.end()) throw InputError(name, "face element has no 'vertex_indices' property");
+  if (!indices->is_list || !IsInteger(indices->type)) {
+    throw InputError(name, "face property '" + indices->name + "' must be a list of integers");
+  }
+  if (header->VertexCount() > mesh_detail::kMaxMeshVertices) {
+    throw InputError(name, "header says " + std::to_string(header->VertexCount()) +
+                               " vertices, more than a mesh can index");
+  }
+  header->face_element = static_cast<std::size_t>(face - elements.begin());
+  header->face_indices = static_cast<std::size_t>(indices - properties.begin());
+}
+
 // Which property of the current element feeds which coordinate (-1: none).
 int AxisOf(const PlyHeader& header, std::size_t element, std::size_t property) {
   if (element != header.vertex_element) return -1;
@@ -185,13 +221,16 @@ int AxisOf(const PlyHeader& header, std::size_t element, std::size_t property) {
 
 class PlyBinaryReader {
  public:
-  PlyBinaryReader(std::string_view bytes, const PlyHeader& header, const std::string& name)
+  // `triangles` receives the faces when reading a mesh (nullptr: a cloud).
+  PlyBinaryReader(std::string_view bytes, const PlyHeader& header, const std::string& name,
+                  TriangleCollector* triangles = nullptr)
       : data_(reinterpret_cast<const unsigned char*>(bytes.data())),
         size_(bytes.size()),
         pos_(header.data_offset),
         header_(header),
         name_(name),
-        little_endian_(header.encoding == PlyEncoding::kBinaryLittleEndian) {}
+        little_endian_(header.encoding == PlyEncoding::kBinaryLittleEndian),
+        triangles_(triangles) {}
 
   PointSet Read() {
     for (std::size_t e = 0; e < header_.elements.size(); ++e) ReadElement(e);
@@ -268,6 +307,7 @@ class PlyBinaryReader {
         }
         pos_ += count_size;
         if (length > Remaining() / SizeOf(property.type)) FailItem(element, i);
+        if (triangles_ != nullptr && header_.IsFaceIndices(e, p)) ReadPolygon(property.type, length, i);
         pos_ += static_cast<std::size_t>(length) * SizeOf(property.type);
       } else {
         const std::size_t size = SizeOf(property.type);
@@ -278,6 +318,21 @@ class PlyBinaryReader {
       }
     }
     if (e == header_.vertex_element) AddVertex(i, xyz[0], xyz[1], xyz[2]);
+  }
+
+  // The `length` indices at pos_ (already checked to be present) of face i.
+  void ReadPolygon(Scalar type, std::uint64_t length, std::uint64_t i) {
+    triangles_->BeginPolygon();
+    for (std::uint64_t k = 0; k < length; ++k) {
+      const unsigned char* item = data_ + pos_ + k * SizeOf(type);
+      std::uint64_t index = 0;
+      const bool non_negative = DecodeCount(item, type, little_endian_, &index);
+      if (!non_negative || !triangles_->AddIndex(index)) {
+        Fail("face " + std::to_string(i) + ": vertex index " + FormatDouble(DecodeScalar(item, type, little_endian_)) +
+             " is not one of the header's " + std::to_string(header_.VertexCount()) + " vertices");
+      }
+    }
+    triangles_->EndPolygon();
   }
 
   [[noreturn]] void FailItem(const PlyElement& element, std::uint64_t i) const {
@@ -295,7 +350,7 @@ class PlyBinaryReader {
     for (std::size_t k = pos_; k < size_; ++k) {
       if (data_[k] != '\n' && data_[k] != '\r' && data_[k] != ' ') {
         Fail(std::to_string(size_ - pos_) + " bytes of unexpected data after the last element "
-             "(header says " + std::to_string(header_.elements[header_.vertex_element].count) +
+             "(header says " + std::to_string(header_.VertexCount()) +
              " vertices)");
       }
     }
@@ -307,23 +362,26 @@ class PlyBinaryReader {
   const PlyHeader& header_;
   const std::string& name_;
   bool little_endian_;
+  TriangleCollector* triangles_;
   PointCollector points_;
 };
 
 class PlyAsciiReader {
  public:
-  PlyAsciiReader(std::string_view bytes, const PlyHeader& header, const std::string& name)
+  PlyAsciiReader(std::string_view bytes, const PlyHeader& header, const std::string& name,
+                 TriangleCollector* triangles = nullptr)
       : reader_(bytes, header.data_offset, header.data_first_line),
         remaining_bytes_(bytes.size() - header.data_offset),
         header_(header),
-        name_(name) {}
+        name_(name),
+        triangles_(triangles) {}
 
   PointSet Read() {
     for (std::size_t e = 0; e < header_.elements.size(); ++e) ReadElement(e);
     std::string_view line;
     if (NextDataLine(&line)) {
       Fail(reader_.line_number(), "unexpected data after the last element (header says " +
-                                      std::to_string(header_.elements[header_.vertex_element].count) +
+                                      std::to_string(header_.VertexCount()) +
                                       " vertices)");
     }
     return points_.Take();
@@ -373,6 +431,9 @@ class PlyAsciiReader {
         }
         ++next;
         if (length > tokens.size() - next) FailCount(element, i, tokens.size());
+        if (triangles_ != nullptr && header_.IsFaceIndices(e, p)) {
+          ReadPolygon(tokens.data() + next, static_cast<std::size_t>(length), i);
+        }
         next += static_cast<std::size_t>(length);
         continue;
       }
@@ -392,6 +453,19 @@ class PlyAsciiReader {
     points_.Add(xyz[0], xyz[1], xyz[2]);
   }
 
+  void ReadPolygon(const std::string_view* indices, std::size_t length, std::uint64_t i) {
+    triangles_->BeginPolygon();
+    for (std::size_t k = 0; k < length; ++k) {
+      std::uint64_t index = 0;
+      if (!ParseCount(indices[k], &index) || !triangles_->AddIndex(index)) {
+        Fail(reader_.line_number(), "face " + std::to_string(i) + ": vertex index " + Quote(indices[k]) +
+                                        " is not one of the header's " +
+                                        std::to_string(header_.VertexCount()) + " vertices");
+      }
+    }
+    triangles_->EndPolygon();
+  }
+
   [[noreturn]] void FailCount(const PlyElement& element, std::uint64_t i, std::size_t found) const {
     if (element.HasLists()) {
       Fail(reader_.line_number(), element.Item(i) + ": list lengths do not match the " +
@@ -406,6 +480,7 @@ class PlyAsciiReader {
   std::size_t remaining_bytes_;
   const PlyHeader& header_;
   const std::string& name_;
+  TriangleCollector* triangles_;
   PointCollector points_;
 };
 
@@ -457,4 +532,20 @@ void WritePlyAscii(const std::string& path, const PointSet& points) {
   });
 }
 
+namespace mesh_detail {
+
+MeshData ParsePlyMesh(std::string_view bytes, const std::string& name) {
+  if (bytes.empty()) throw InputError(name, "empty file");
+  cloud_detail::PlyHeader header = cloud_detail::PlyHeaderParser(bytes, name).Parse();
+  cloud_detail::FindFaceIndices(&header, name);
+  TriangleCollector triangles(header.VertexCount());
+  MeshData mesh;
+  mesh.vertices = header.encoding == cloud_detail::PlyEncoding::kAscii
+                      ? cloud_detail::PlyAsciiReader(bytes, header, name, &triangles).Read()
+                      : cloud_detail::PlyBinaryReader(bytes, header, name, &triangles).Read();
+  mesh.triangles = triangles.Take();
+  return mesh;
+}
+
+}  // namespace mesh_detail
 }  // namespace c3po

@@ -211,7 +211,7 @@ TEST_CASE("bad mesh files give an InputError naming the file") {
 
   WriteText(dir / "empty.obj", "");
   CheckLoadFails(dir / "empty.obj");
-  // Counts the file cannot hold are rejected before assimp allocates them
+  // Counts the file cannot hold are rejected before anything is allocated
   // (the fuzzer's OFF header claiming 8.9e9 faces asked for 48 GB).
   const std::string cube_off_body =
       "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n"

@@ -25,6 +25,8 @@ namespace fs = std::filesystem;
 struct ObjCounts {
   Eigen::AlignedBox3d box;
   int faces = 0;
+  int vertices = 0;
+  int encoder_vertices = -1;   // the encoder's "# Vertices: N" comment
 };
 
 // Only "v x y z" and "f ..." lines: all a bounding box and a face count need.
@@ -33,7 +35,9 @@ ObjCounts ReadObjCounts(const std::string& path) {
   std::ifstream in(path);
   std::string line;
   while (std::getline(in, line)) {
+    if (line.rfind("# Vertices: ", 0) == 0) counts.encoder_vertices = std::stoi(line.substr(12));
     if (line.rfind("v ", 0) == 0) {
+      ++counts.vertices;
       std::istringstream fields(line.substr(2));
       Eigen::Vector3d v;
       fields >> v.x() >> v.y() >> v.z();
@@ -87,12 +91,14 @@ TEST_CASE("YCB meshes: load, sample, diameter, README sizes, keypoints on the su
     const ObjCounts counts = ReadObjCounts(obj);
     const c3po::Mesh mesh = c3po::LoadMesh(obj);
 
-    // assimp sees every face (all are triangles) and the same vertex extent
-    // (it stores single-precision floats: ~1e-7 m at this scale).
+    // c3po's OBJ reader sees every face (all are triangles), every vertex the
+    // encoder says it wrote (all are used), and the same extent in doubles.
     CHECK(mesh.triangles.cols() == counts.faces);
+    CHECK(mesh.vertices.cols() == counts.vertices);
+    CHECK(counts.vertices == counts.encoder_vertices);
     const Eigen::AlignedBox3d box = mesh.BoundingBox();
-    CHECK((box.min() - counts.box.min()).cwiseAbs().maxCoeff() < 1e-6);
-    CHECK((box.max() - counts.box.max()).cwiseAbs().maxCoeff() < 1e-6);
+    CHECK((box.min() - counts.box.min()).cwiseAbs().maxCoeff() < 1e-15);
+    CHECK((box.max() - counts.box.max()).cwiseAbs().maxCoeff() < 1e-15);
 
     c3po::ObjectSpec spec;
     spec.name = name;

@@ -1,5 +1,5 @@
 #pragma once
-// Triangle meshes: loading (assimp: OBJ, PLY, STL, OFF, glTF, ...), writing
+// Triangle meshes: loading (PLY: own reader; OBJ, STL, OFF, glTF, ...: assimp), writing
 // OBJ, area-weighted surface sampling and closest-point queries.
 #include <cstdint>
 #include <string>
@@ -21,9 +21,11 @@ struct Mesh {
   void Validate() const;
 };
 
-// Loads any mesh assimp reads, merges all its meshes, scales coordinates by
-// `scale` (e.g. 0.001 for a mesh in millimetres). Throws InputError("path:
-// ...") when the file is missing, unreadable or has no triangles.
+// Loads a triangle mesh (PLY with c3po's own reader, every other format --
+// OBJ, STL, OFF, glTF, ... -- with assimp), merges all its meshes, drops
+// vertices no triangle uses and scales coordinates by `scale` (e.g. 0.001 for
+// a mesh in millimetres). Throws InputError("path: ...") when the file is
+// missing, unreadable or has no triangles.
 Mesh LoadMesh(const std::string& path, double scale = 1.0);
 
 // Writes a Wavefront OBJ atomically.
