@@ -5,7 +5,8 @@ namespace c3po::cli {
 
 void SetupSynthBench(CLI::App& parent, std::function<int()>* run);
 void SetupPointNetBench(CLI::App& parent, std::function<int()>* run);
+void SetupMeshBench(CLI::App& parent, std::function<int()>* run);
 
-std::vector<BenchEntry> BenchEntries() { return {{SetupSynthBench}, {SetupPointNetBench}}; }
+std::vector<BenchEntry> BenchEntries() { return {{SetupSynthBench}, {SetupPointNetBench}, {SetupMeshBench}}; }
 
 }  // namespace c3po::cli
