@@ -3,6 +3,7 @@
 // counts "vertices faces [edges]" (on the header line or the next), then one
 // vertex "x y z ..." per line and one face "n i1 ... in [colour]" per line.
 // '#' starts a comment. The counts are never trusted for allocation.
+// ModelNet's "OFF490 518 0" (count glued to the keyword) is read as well.
 #include "c3po/error.hpp"
 #include "cloud_io_internal.hpp"
 #include "mesh_io_internal.hpp"
@@ -41,6 +42,7 @@ class OffReader {
 
   void ReadHeader() {
     if (!NextTokens()) throw InputError(name_, "empty file (no OFF header)");
+    SplitGluedCount();
     const std::string_view keyword = tokens_[0];
     if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF") {
       Fail("not an OFF file (first word " + Quote(keyword) + ", expected OFF)");
@@ -59,6 +61,15 @@ class OffReader {
       Fail("expected the counts 'vertices faces edges'");
     }
     if (vertex_count_ > kMaxMeshVertices) Fail("more vertices than a mesh can index");
+  }
+
+  // ModelNet's OFF files glue the vertex count to the keyword ("OFF490 518 0").
+  void SplitGluedCount() {
+    const std::string_view first = tokens_[0];
+    if (first.size() > 3 && first.substr(0, 3) == "OFF" && first[3] >= '0' && first[3] <= '9') {
+      tokens_[0] = first.substr(0, 3);
+      tokens_.insert(tokens_.begin() + 1, first.substr(3));
+    }
   }
 
   void ReadVertex(std::uint64_t i) {

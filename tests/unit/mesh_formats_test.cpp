@@ -150,10 +150,15 @@ std::string ObjTextWithAttributes(const PolygonSoup& soup) {
   return out.str();
 }
 
-std::string OffText(const PolygonSoup& soup, bool counts_on_header_line) {
+// Counts on their own line, on the header line, or glued to the keyword as
+// in ModelNet ("OFF490 518 0").
+enum class OffCounts { kOwnLine, kHeaderLine, kGlued };
+
+std::string OffText(const PolygonSoup& soup, OffCounts counts = OffCounts::kOwnLine) {
   std::ostringstream out;
   out.precision(9);
-  out << "# made by a test\n" << (counts_on_header_line ? "OFF " : "OFF\n# counts:\n")
+  const char* header = counts == OffCounts::kOwnLine ? "OFF\n# counts:\n" : counts == OffCounts::kHeaderLine ? "OFF " : "OFF";
+  out << (counts == OffCounts::kGlued ? "" : "# made by a test\n") << header
       << soup.vertices.size() << ' ' << soup.faces.size() << " 0\n";
   for (const auto& p : soup.vertices) out << p.x() << ' ' << p.y() << ' ' << p.z() << "  # vertex\n";
   out << "\n";
@@ -300,8 +305,9 @@ TEST_CASE("every own format and variant loads random polygons to their exact are
       {"soup_be.ply", BinaryPly(soup, true, "uchar", 1, "int", 4)},
       {"soup.obj", ObjText(soup)},
       {"soup_attributes.obj", ObjTextWithAttributes(soup)},
-      {"soup.off", OffText(soup, false)},
-      {"soup_counts_on_header.off", OffText(soup, true)},
+      {"soup.off", OffText(soup)},
+      {"soup_counts_on_header.off", OffText(soup, OffCounts::kHeaderLine)},
+      {"soup_modelnet.off", OffText(soup, OffCounts::kGlued)},
       {"soup_ascii.stl", StlAscii(soup)},
       {"soup_binary.stl", StlBinary(soup, "binary soup")},
       {"soup_binary_solid.stl", StlBinary(soup, "solid soup, yet binary")},   // told apart by size
@@ -329,7 +335,7 @@ TEST_CASE("formats c3po does not read itself still load through assimp") {
   // assimp must not route a file named .gltf to its own OBJ, OFF or STL
   // importer by signature: those are removed before it reads. (PLY content
   // is recognised by its first line and read by c3po under any name.)
-  for (const std::string& other : {ObjText(soup), OffText(soup, false), StlAscii(soup)}) {
+  for (const std::string& other : {ObjText(soup), OffText(soup), StlAscii(soup)}) {
     CHECK_FALSE(LoadsOrInputError(dir / "other.gltf", other));
   }
 }
@@ -490,7 +496,7 @@ TEST_CASE("every truncation and every early-byte corruption of a mesh file is re
       {"m.ply", AsciiPly(soup)},
       {"m.ply", BinaryPly(soup, false, "uchar", 1, "int", 4)},
       {"m.obj", ObjTextWithAttributes(soup)},
-      {"m.off", OffText(soup, false)},
+      {"m.off", OffText(soup)},
       {"m.stl", StlAscii(soup)},
       {"m.stl", StlBinary(soup, "solid")},
   };
