@@ -34,16 +34,10 @@ for t in "${targets[@]}"; do
   mkdir -p "$work" "$artifacts"
   log=$build/fuzz-logs/$t.log
   mkdir -p "$(dirname "$log")"
-  # mesh: assimp 5.2's OBJ importer leaks on some malformed files (inside
-  # libassimp, behind our RAII Importer; seed corpus/mesh/assimp_obj_leak);
-  # leak checks there would only report that, so they are off for mesh.
-  # (-detect_leaks=0 for libFuzzer, ASAN_OPTIONS for the check at exit).
-  extra=(); asan=${ASAN_OPTIONS:-}
-  [ "$t" = mesh ] && extra=(-detect_leaks=0) && asan=detect_leaks=0
   # Seed folders that exist (git keeps no empty folder in a clean clone).
   seeds=()
   for dir in "$src/tests/fuzz/corpus/$t" $(seeds_for "$t"); do [ -d "$dir" ] && seeds+=("$dir"); done
-  ASAN_OPTIONS=$asan "$exe" "$work" "${seeds[@]}" "${extra[@]}" \
+  "$exe" "$work" "${seeds[@]}" \
     -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
     -artifact_prefix="$artifacts/" >"$log" 2>&1
   code=$?
