@@ -112,6 +112,19 @@ check object_index_range "2" - out_of_range.json out_of_range.json one_point.xyz
 : > empty_object.json
 check object_empty "2" - empty_object.json empty_object.json -- "$C3PO" certify empty_object.json --detector svd one_point.xyz
 
+# --- meshes (an object's CAD file; c3po's own PLY/OBJ/OFF/STL readers) -------
+# The damaged PLY header once aborted inside assimp; the OFF counts made it
+# allocate 30 GB; the binary STL claims more triangles than it holds.
+printf 'ply\nformat ascii 1mment unit cube\nelement vertex 8\nproperty float x\nend_header\n' > broken.ply
+printf '1\r\r\r\r%s\r\r%%' "$(printf '7%.0s' $(seq 84))" > huge_count.off
+{ printf '%-80s' binary; printf '\xff\xff\xff\x0f'; head -c 120 /dev/zero; } > truncated.stl
+for mesh in broken.ply huge_count.off truncated.stl; do
+  sed "s|\"cube.obj\"|\"$mesh\"|" cube.json > "mesh_$mesh.json"
+  grep -q "\"$mesh\"" "mesh_$mesh.json" || { echo "FAIL: could not point cube.json at $mesh"; failures=$((failures + 1)); }
+  check "mesh_${mesh//./_}" "2" - "$mesh" "$mesh" "mesh_$mesh.json" -- "$C3PO" certify "mesh_$mesh.json" --detector svd sim/000000.ply
+done
+check annotate_broken_mesh "2" broken.json broken.ply broken.ply -- "$C3PO" annotate broken.ply -o broken.json --auto 8
+
 # --- datasets ---------------------------------------------------------------
 mkdir -p no_manifest && cp sim/000000.ply no_manifest/
 check dataset_no_manifest "2" - no_manifest no_manifest -- "$C3PO" certify "$CUBE" --detector svd --data no_manifest
