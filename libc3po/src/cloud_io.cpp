@@ -163,6 +163,13 @@ bool AllFinite(double x, double y, double z) {
   return std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
 }
 
+std::string ParseCoordinates(const std::string_view* tokens, double xyz[3]) {
+  for (int k = 0; k < 3; ++k) {
+    if (!ParseDouble(tokens[k], &xyz[k])) return Quote(tokens[k]) + " is not a number";
+  }
+  return AllFinite(xyz[0], xyz[1], xyz[2]) ? "" : "non-finite coordinate";
+}
+
 void AppendFloat32LE(std::string* out, float value) {
   std::uint32_t bits;
   std::memcpy(&bits, &value, sizeof bits);

@@ -66,6 +66,9 @@ class PointCollector {
 
 // "vertex 17: non-finite coordinate" style check; `what` names the point.
 bool AllFinite(double x, double y, double z);
+// Reads the point tokens[0..2] into xyz (the mesh readers' vertices).
+// Returns "" or the problem: "'x' is not a number" or "non-finite coordinate".
+std::string ParseCoordinates(const std::string_view* tokens, double xyz[3]);
 
 // Format-specific parsers; `name` is used in every message.
 PointSet ParsePly(std::string_view bytes, const std::string& name);

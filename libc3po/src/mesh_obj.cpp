@@ -36,10 +36,8 @@ class ObjReader {
   void ReadVertex() {
     if (tokens_.size() < 4) Fail("a vertex needs 3 coordinates ('v x y z')");
     double xyz[3];
-    for (int k = 0; k < 3; ++k) {
-      if (!cloud_detail::ParseDouble(tokens_[k + 1], &xyz[k])) Fail(Quote(tokens_[k + 1]) + " is not a number");
-    }
-    if (!cloud_detail::AllFinite(xyz[0], xyz[1], xyz[2])) Fail("vertex with a non-finite coordinate");
+    const std::string problem = cloud_detail::ParseCoordinates(tokens_.data() + 1, xyz);
+    if (!problem.empty()) Fail(problem);
     if (vertices_.size() >= kMaxMeshVertices) Fail("more vertices than a mesh can index");
     vertices_.Add(xyz[0], xyz[1], xyz[2]);
     triangles_.set_vertex_count(vertices_.size());

@@ -76,10 +76,8 @@ class OffReader {
     if (!NextTokens()) Truncated("vertices", vertex_count_, i);
     if (tokens_.size() < 3) Fail("vertex " + std::to_string(i) + " needs 3 coordinates");
     double xyz[3];
-    for (int k = 0; k < 3; ++k) {
-      if (!cloud_detail::ParseDouble(tokens_[k], &xyz[k])) Fail(Quote(tokens_[k]) + " is not a number");
-    }
-    if (!cloud_detail::AllFinite(xyz[0], xyz[1], xyz[2])) Fail("vertex " + std::to_string(i) + ": non-finite coordinate");
+    const std::string problem = cloud_detail::ParseCoordinates(tokens_.data(), xyz);
+    if (!problem.empty()) Fail(problem);
     vertices_.Add(xyz[0], xyz[1], xyz[2]);
   }
 

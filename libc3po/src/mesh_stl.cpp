@@ -13,8 +13,6 @@
 namespace c3po::mesh_detail {
 namespace {
 
-using cloud_detail::Quote;
-
 constexpr std::size_t kHeaderBytes = 84;     // 80-byte comment + uint32 count
 constexpr std::size_t kTriangleBytes = 50;   // 12 float32 + uint16
 
@@ -112,10 +110,8 @@ MeshData ParseAscii(std::string_view bytes, const std::string& name) {
     if (tokens[0] != "vertex") continue;
     if (tokens.size() != 4) fail("expected 'vertex x y z'");
     double xyz[3];
-    for (int k = 0; k < 3; ++k) {
-      if (!cloud_detail::ParseDouble(tokens[k + 1], &xyz[k])) fail(Quote(tokens[k + 1]) + " is not a number");
-    }
-    if (!cloud_detail::AllFinite(xyz[0], xyz[1], xyz[2])) fail("vertex with a non-finite coordinate");
+    const std::string problem = cloud_detail::ParseCoordinates(tokens.data() + 1, xyz);
+    if (!problem.empty()) fail(problem);
     triangles.AddIndex(static_cast<std::uint64_t>(corners.IndexOf(xyz[0], xyz[1], xyz[2])));
   }
   return {corners.Take(), triangles.Take()};
