@@ -9,6 +9,8 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <future>
+#include <thread>
 #include <vector>
 
 #include "c3po/parallel.hpp"
@@ -171,22 +173,90 @@ TEST_CASE("ParallelFor runs every index exactly once") {
   }
 }
 
-TEST_CASE("ParallelFor propagates an exception and stops") {
+TEST_CASE("ParallelFor propagates the first exception; each index runs at most once") {
   for (int threads : {1, 2, 4}) {
     CAPTURE(threads);
-    std::atomic<int> calls{0};
+    std::vector<std::atomic<int>> hits(100000);
     try {
       c3po::ParallelFor(0, 100000, [&](int i) {
-        calls.fetch_add(1);
+        hits[i].fetch_add(1);
         if (i == 37) throw std::runtime_error("item 37 failed");
       }, threads);
       FAIL_CHECK("no exception");
     } catch (const std::runtime_error& e) {
       CHECK(std::string(e.what()) == "item 37 failed");
     }
-    CHECK(calls.load() < 100000);  // the remaining items were skipped
+    int twice = 0, ran = 0;
+    for (auto& h : hits) {
+      twice += h.load() > 1 ? 1 : 0;
+      ran += h.load();
+    }
+    CHECK(twice == 0);
+    CHECK(hits[37].load() == 1);
+    // One thread claims in order and stops at the failing item: exactly 0..37 ran.
+    if (threads == 1) CHECK(ran == 38);
   }
   CHECK_THROWS_AS(c3po::ParallelFor(0, 10, [](int) { throw std::logic_error("x"); }, 2), std::logic_error);
+}
+
+TEST_CASE("IndexQueue hands out every index once across threads") {
+  c3po::IndexQueue queue(-5, 20000);
+  std::vector<std::atomic<int>> hits(20005);
+  std::vector<std::thread> pool;
+  for (int t = 0; t < 4; ++t) {
+    pool.emplace_back([&] {
+      int i = 0;
+      while (queue.Claim(&i)) hits[i + 5].fetch_add(1);
+    });
+  }
+  for (auto& thread : pool) thread.join();
+  int wrong = 0;
+  for (auto& h : hits) wrong += h.load() == 1 ? 0 : 1;
+  CHECK(wrong == 0);
+  int i = 0;
+  CHECK_FALSE(queue.Claim(&i));
+  CHECK(queue.Stop() == 20005);
+}
+
+TEST_CASE("IndexQueue: no index is claimed after Stop() returns, on any thread") {
+  // Deterministic: the claimers start only after Stop() has returned (a
+  // promise released by the stopping thread), so every one of their claims
+  // is ordered after the stop; none may succeed however threads interleave.
+  for (int round = 0; round < 50; ++round) {
+    c3po::IndexQueue queue(0, 1000);
+    int first = -1;
+    REQUIRE(queue.Claim(&first));
+    CHECK(first == 0);
+    std::promise<void> stopped;
+    std::shared_future<void> after_stop = stopped.get_future().share();
+    std::atomic<int> claimed_after_stop{0};
+    std::vector<std::thread> pool;
+    for (int t = 0; t < 3; ++t) {
+      pool.emplace_back([&] {
+        after_stop.wait();
+        int i = 0;
+        for (int k = 0; k < 100; ++k) claimed_after_stop.fetch_add(queue.Claim(&i) ? 1 : 0);
+      });
+    }
+    const int claimed_before = queue.Stop();
+    stopped.set_value();
+    for (auto& thread : pool) thread.join();
+    CHECK(claimed_before == 1);
+    CHECK(queue.stopped());
+    CHECK(claimed_after_stop.load() == 0);
+  }
+}
+
+TEST_CASE("IndexQueue: Stop() counts the claims that preceded it") {
+  c3po::IndexQueue queue(10, 20);
+  int i = 0;
+  for (int k = 0; k < 4; ++k) REQUIRE(queue.Claim(&i));
+  CHECK(i == 13);
+  CHECK(queue.Stop() == 4);
+  CHECK_FALSE(queue.Claim(&i));
+  c3po::IndexQueue empty(5, 3);
+  CHECK_FALSE(empty.Claim(&i));
+  CHECK(empty.Stop() == 0);
 }
 
 TEST_CASE("per-item streams make parallel results independent of threading") {
