@@ -8,11 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "c3po/annotate.hpp"
-#include "c3po/error.hpp"
-#include "c3po/html_view.hpp"
-#include "c3po/mesh.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/authoring/annotate.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/web/annotation_page.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/object/object_io.hpp"
 #include "command.hpp"
 
 namespace c3po::cli {

@@ -6,11 +6,11 @@
 #include <sstream>
 
 #include "bench_registry.hpp"
-#include "c3po/atomic_file.hpp"
-#include "c3po/corrector_benchmark.hpp"
-#include "c3po/dataset.hpp"
-#include "c3po/error.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/eval/corrector_benchmark.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/object/object_io.hpp"
 #include "command.hpp"
 #include "common.hpp"
 
@@ -153,7 +153,7 @@ void SetupCorrectorBench(CLI::App& parent, std::function<int()>* run) {
   sub->add_option("--json", cmd->json_path, "Also write the rows as JSON to this file");
   sub->add_option("--cases", cmd->cases_path,
                   "Also write every case (input keypoints, result) and the model sample as JSON lines "
-                  "(input of libc3po/bench/pytorch_corrector_gd.py)");
+                  "(input of libc3po/eval/bench/pytorch_corrector_gd.py)");
   sub->footer("Example:\n  c3po bench corrector drill.json --data data/drill_depth --sigma 0.1,0.3,0.5 --solvers fast,gd");
   sub->callback([cmd, run]() { *run = [cmd]() { return RunCorrectorBench(*cmd); }; });
 }

@@ -8,8 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "c3po/error.hpp"
-#include "c3po/mesh.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/io/mesh_io.hpp"
 #include "command.hpp"
 
 namespace c3po::cli {

@@ -4,7 +4,7 @@
 #include <functional>
 #include <memory>
 
-#include "c3po/error.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/plugins/pointnet.hpp"
 #include "command.hpp"
 

@@ -5,10 +5,11 @@
 #include <memory>
 #include <string>
 
-#include "c3po/error.hpp"
-#include "c3po/mesh.hpp"
-#include "c3po/object_io.hpp"
-#include "c3po/synth.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/synth/synth.hpp"
 #include "command.hpp"
 
 namespace c3po::cli {

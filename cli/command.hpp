@@ -21,8 +21,4 @@ RunFunction SetupEval(CLI::App& command);
 RunFunction SetupBench(CLI::App& command);
 RunFunction SetupDemo(CLI::App& command);
 
-// For a subcommand whose implementation has not landed yet: accepts any
-// arguments, says so on stderr and exits with status 2.
-RunFunction NotBuiltYet(CLI::App& command, const char* issue_title);
-
 }  // namespace c3po::cli

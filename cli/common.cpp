@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <mutex>
 
-#include "c3po/interrupt.hpp"
+#include "c3po/base/interrupt.hpp"
 #include "command.hpp"
 
 namespace c3po::cli {
@@ -59,16 +59,6 @@ void InstallInterruptHandlers() {
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
-}
-
-RunFunction NotBuiltYet(CLI::App& command, const char* issue_title) {
-  command.allow_extras();
-  const std::string name = command.get_name();
-  const std::string title = issue_title;
-  return [name, title]() -> int {
-    std::fprintf(stderr, "c3po %s: not built yet (issue \"%s\")\n", name.c_str(), title.c_str());
-    return 2;
-  };
 }
 
 }  // namespace c3po::cli

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "c3po/error.hpp"
-#include "c3po/interrupt.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/base/interrupt.hpp"
 #include "command.hpp"
 
 extern char** environ;
@@ -96,6 +96,9 @@ double Step(const std::string& title, const std::vector<std::string>& args) {
 }
 
 int Run(DemoCommand cmd) {
+#ifndef C3PO_HAVE_POINTNET
+  throw InputError("needs the pointnet detector, and this c3po was built without it (C3PO_WITH_POINTNET=OFF)");
+#endif
   const auto start = std::chrono::steady_clock::now();
   if (cmd.object.empty()) cmd.object = DefaultObject();
   if (cmd.quick) {

@@ -8,13 +8,13 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/dataset.hpp"
-#include "c3po/error.hpp"
-#include "c3po/evaluation.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/eval/evaluation.hpp"
+#include "c3po/object/object_io.hpp"
 #include "c3po/plugins/registry.hpp"
-#include "c3po/report.hpp"
+#include "c3po/web/report.hpp"
 #include "command.hpp"
 #include "common.hpp"
 

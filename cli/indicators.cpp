@@ -5,11 +5,11 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/dataset.hpp"
-#include "c3po/error.hpp"
-#include "c3po/indicators.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/authoring/indicators.hpp"
+#include "c3po/object/object_io.hpp"
 #include "command.hpp"
 #include "common.hpp"
 

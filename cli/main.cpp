@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "c3po/error.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/plugins/registry.hpp"
 #include "command.hpp"
 #include "common.hpp"

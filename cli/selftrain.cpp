@@ -6,12 +6,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "c3po/auto_threshold.hpp"
-#include "c3po/dataset.hpp"
-#include "c3po/error.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/method/auto_threshold.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/object/object_io.hpp"
 #include "c3po/plugins/pointnet.hpp"
-#include "c3po/selftrain.hpp"
+#include "c3po/method/selftrain.hpp"
 #include "command.hpp"
 #include "common.hpp"
 #include "training_common.hpp"

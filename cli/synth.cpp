@@ -8,9 +8,9 @@
 #include <string>
 #include <tuple>
 
-#include "c3po/error.hpp"
-#include "c3po/object_io.hpp"
-#include "c3po/synth.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/synth/synth.hpp"
 #include "command.hpp"
 #include "common.hpp"
 

@@ -5,9 +5,9 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "c3po/dataset.hpp"
-#include "c3po/error.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/object/object_io.hpp"
 #include "c3po/plugins/pointnet.hpp"
 #include "command.hpp"
 #include "common.hpp"

@@ -5,8 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/parallel.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/parallel.hpp"
 #include "common.hpp"
 
 namespace c3po::cli {

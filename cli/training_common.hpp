@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "c3po/dataset.hpp"
-#include "c3po/detector.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/method/detector.hpp"
 
 namespace c3po::cli {
 

@@ -3,7 +3,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "c3po/error.hpp"
+#include "c3po/base/error.hpp"
 #include "registry_internal.hpp"
 
 namespace c3po {

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#include "c3po/error.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/plugins/plugin_api.h"
 #include "registry_internal.hpp"
 

@@ -4,7 +4,7 @@
 #include <mutex>
 #include <stdexcept>
 
-#include "c3po/error.hpp"
+#include "c3po/base/error.hpp"
 #include "registry_internal.hpp"
 
 namespace c3po {

@@ -2,8 +2,8 @@
 // Small procedural meshes for unit tests (independent of the bundled objects).
 #include <vector>
 
-#include "c3po/mesh.hpp"
-#include "c3po/object_model.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po::test {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "c3po/procedural.hpp"
+#include "c3po/object/procedural.hpp"
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {

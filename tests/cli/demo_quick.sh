@@ -5,6 +5,7 @@
 set -euo pipefail
 C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
 rm -rf "$WORK"; mkdir -p "$WORK"; cd "$SRC"
+[ "${C3PO_WITH_POINTNET:-ON}" != OFF ] || { echo "SKIP: the demo trains the pointnet detector (C3PO_WITH_POINTNET=OFF)"; exit 77; }
 "$C3PO" demo --quick --out "$WORK/out" > "$WORK/demo.log" 2>&1 || { tail -20 "$WORK/demo.log"; exit 1; }
 for f in sim/manifest.jsonl sim.model self.model supervised.model depth_test/manifest.jsonl report.html eval.json \
          sim.model.log.jsonl self.model.log.jsonl; do

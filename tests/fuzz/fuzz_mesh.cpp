@@ -1,8 +1,9 @@
 // libFuzzer target: c3po::LoadMesh on arbitrary bytes; the first byte picks
 // the file extension (.obj, .ply, .off, .stl: c3po's own readers), the rest is
 // the file. Leak checks are on (assimp, which leaked, no longer reads these).
-#include "c3po/error.hpp"
-#include "c3po/mesh.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/io/mesh_io.hpp"
 #include "fuzz_common.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

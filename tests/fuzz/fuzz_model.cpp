@@ -2,7 +2,7 @@
 // fixed identity: tests/fixtures/objects/cube.json, for which the seed model
 // corpus/model/cube.model was trained (c3po train --epochs 1 --point-mlp 8 8
 // --head 8 --points 32 on 8 sim clouds).
-#include "c3po/error.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/plugins/pointnet.hpp"
 #include "fuzz_common.hpp"
 

@@ -1,8 +1,8 @@
 // libFuzzer target: c3po::ReadObjectSpec on arbitrary bytes (no parse-from-
 // string entry point exists, so the bytes go through a scratch file). A valid
 // cube.obj sits next to it so that well-formed JSON reaches the mesh checks.
-#include "c3po/error.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/object/object_io.hpp"
 #include "fuzz_common.hpp"
 
 namespace {

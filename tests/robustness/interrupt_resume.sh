@@ -57,6 +57,8 @@ check_resume() {
   else fail "$name: resumed model differs from the uninterrupted run"; fi
 }
 
+# train and selftrain need the pointnet detector (not in a C3PO_WITH_POINTNET=OFF build).
+if [ "${C3PO_WITH_POINTNET:-ON}" != OFF ]; then
 "$C3PO" train "$OBJ" "${TRAIN[@]}" -o ref_train.model > ref_train.out 2> ref_train.err || { echo "reference train failed"; exit 2; }
 echo "reference train: $(grep -c '^epoch' ref_train.err) epochs"
 interrupt train INT "$C3PO" train "$OBJ" "${TRAIN[@]}" -o cut_train.model
@@ -66,6 +68,7 @@ check_resume train cut_train.model ref_train.model "$C3PO" train "$OBJ" "${TRAIN
 echo "reference selftrain: $(grep -c '^epoch' ref_self.err) epochs"
 interrupt selftrain TERM "$C3PO" selftrain "$OBJ" "${SELF[@]}" -o cut_self.model
 check_resume selftrain cut_self.model ref_self.model "$C3PO" selftrain "$OBJ" "${SELF[@]}" -o cut_self.model --resume
+fi
 
 # --- synth ------------------------------------------------------------------
 # interrupt_synth NAME SIGNAL DIR: synth into DIR, signalled once its hidden

@@ -8,12 +8,13 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "c3po/annotate.hpp"
-#include "c3po/atomic_file.hpp"
-#include "c3po/error.hpp"
-#include "c3po/html_view.hpp"
-#include "c3po/object_io.hpp"
-#include "c3po/random.hpp"
+#include "c3po/authoring/annotate.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/web/annotation_page.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/base/random.hpp"
 #include "test_helpers.hpp"
 
 namespace {

@@ -2,8 +2,8 @@
 // A small asymmetric test object (no proper rotational symmetry): the union of
 // three boxes of different sizes forming an L with a post, d ~ 0.25 m.
 // Used by the ICP and svd-detector tests.
-#include "c3po/mesh.hpp"
-#include "c3po/object_model.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po::test {
 

@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/error.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
 #include "test_helpers.hpp"
 
 namespace {

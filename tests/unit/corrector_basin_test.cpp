@@ -5,10 +5,10 @@
 // the restarts also solve one that gd does not.)
 #include <doctest/doctest.h>
 
-#include "c3po/corrector.hpp"
-#include "c3po/metrics.hpp"
-#include "c3po/registration.hpp"
-#include "c3po/synth.hpp"
+#include "c3po/method/corrector.hpp"
+#include "c3po/eval/metrics.hpp"
+#include "c3po/geometry/registration.hpp"
+#include "c3po/synth/synth.hpp"
 #include "test_objects.hpp"
 
 using namespace c3po;

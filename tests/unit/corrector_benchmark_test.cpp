@@ -1,12 +1,12 @@
 // The corrector benchmark: rows per (sigma, method), and the per-cloud cases it
 // records are a faithful record (rerunning the corrector on a case's input
-// reproduces its result), as libc3po/bench/pytorch_corrector_gd.py relies on.
+// reproduces its result), as libc3po/eval/bench/pytorch_corrector_gd.py relies on.
 #include <doctest/doctest.h>
 
-#include "c3po/certificate.hpp"
-#include "c3po/corrector_benchmark.hpp"
-#include "c3po/dataset.hpp"
-#include "c3po/synth.hpp"
+#include "c3po/method/certificate.hpp"
+#include "c3po/eval/corrector_benchmark.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/synth/synth.hpp"
 #include "test_helpers.hpp"
 #include "test_objects.hpp"
 

@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <thread>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/cloud_io.hpp"
-#include "c3po/dataset.hpp"
-#include "c3po/error.hpp"
-#include "c3po/random.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/io/cloud_io.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/base/random.hpp"
 #include "test_helpers.hpp"
 
 namespace fs = std::filesystem;

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <limits>
 
-#include "c3po/error.hpp"
-#include "c3po/evaluation.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/eval/evaluation.hpp"
 #include "evaluation_fixture.hpp"
 #include "test_helpers.hpp"
 

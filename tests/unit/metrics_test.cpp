@@ -6,9 +6,9 @@
 #include <limits>
 #include <vector>
 
-#include "c3po/error.hpp"
-#include "c3po/metrics.hpp"
-#include "c3po/random.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/eval/metrics.hpp"
+#include "c3po/base/random.hpp"
 
 namespace {
 

@@ -12,9 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "c3po/error.hpp"
-#include "c3po/mesh.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/object/object_io.hpp"
 #include "test_helpers.hpp"
 
 namespace {

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "c3po/error.hpp"
-#include "c3po/interrupt.hpp"
-#include "c3po/object_io.hpp"
-#include "c3po/random.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/base/interrupt.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/base/random.hpp"
 #include "test_helpers.hpp"
 
 #if __has_include(<c3po/plugins/pointnet.hpp>)

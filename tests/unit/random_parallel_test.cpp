@@ -13,8 +13,8 @@
 #include <thread>
 #include <vector>
 
-#include "c3po/parallel.hpp"
-#include "c3po/random.hpp"
+#include "c3po/base/parallel.hpp"
+#include "c3po/base/random.hpp"
 
 namespace {
 

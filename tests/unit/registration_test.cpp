@@ -9,8 +9,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "c3po/random.hpp"
-#include "c3po/registration.hpp"
+#include "c3po/base/random.hpp"
+#include "c3po/geometry/registration.hpp"
 
 namespace {
 

@@ -7,10 +7,11 @@
 #include <set>
 #include <tuple>
 
-#include "c3po/error.hpp"
-#include "c3po/procedural.hpp"
-#include "c3po/random.hpp"
-#include "c3po/render.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/object/procedural.hpp"
+#include "c3po/base/random.hpp"
+#include "c3po/geometry/render.hpp"
 #include "test_helpers.hpp"
 
 namespace {

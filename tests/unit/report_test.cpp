@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 #include <cstring>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/error.hpp"
-#include "c3po/evaluation.hpp"
-#include "c3po/report.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/eval/evaluation.hpp"
+#include "c3po/web/report.hpp"
 #include "evaluation_fixture.hpp"
 #include "test_helpers.hpp"
 

@@ -5,10 +5,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/error.hpp"
-#include "c3po/random.hpp"
-#include "c3po/selftrain.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/base/random.hpp"
+#include "c3po/method/selftrain.hpp"
 #include "test_helpers.hpp"
 #include "test_objects.hpp"
 

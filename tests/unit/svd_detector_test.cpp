@@ -6,12 +6,12 @@
 #include <limits>
 
 #include "asymmetric_object.hpp"
-#include "c3po/error.hpp"
-#include "c3po/metrics.hpp"
-#include "c3po/object_io.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/eval/metrics.hpp"
+#include "c3po/object/object_io.hpp"
 #include "c3po/plugins/svd_detector.hpp"
-#include "c3po/random.hpp"
-#include "c3po/render.hpp"
+#include "c3po/base/random.hpp"
+#include "c3po/geometry/render.hpp"
 #include "test_helpers.hpp"
 // Internal to the svd plugin (linked through c3po::plugins).
 #include "../../plugins/svd/src/distance_grid.hpp"

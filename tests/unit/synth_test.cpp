@@ -10,11 +10,12 @@
 #include <sstream>
 #include <tuple>
 
-#include "c3po/dataset.hpp"
-#include "c3po/error.hpp"
-#include "c3po/interrupt.hpp"
-#include "c3po/procedural.hpp"
-#include "c3po/synth.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/base/interrupt.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/object/procedural.hpp"
+#include "c3po/synth/synth.hpp"
 #include "test_helpers.hpp"
 
 namespace fs = std::filesystem;

@@ -14,8 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "c3po/mesh.hpp"
-#include "c3po/object_model.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/object/object_model.hpp"
 #include "test_helpers.hpp"
 
 namespace {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <numeric>
 
-#include "c3po/error.hpp"
+#include "c3po/base/error.hpp"
 
 namespace c3po::pointnet {
 

@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <cstring>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/error.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
 
 namespace c3po::pointnet {
 namespace {

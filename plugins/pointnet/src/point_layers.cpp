@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "c3po/parallel.hpp"
+#include "c3po/base/parallel.hpp"
 
 namespace c3po::pointnet {
 namespace {

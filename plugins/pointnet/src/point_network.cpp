@@ -3,8 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "c3po/parallel.hpp"
-#include "c3po/random.hpp"
+#include "c3po/base/parallel.hpp"
+#include "c3po/base/random.hpp"
 #include "head_layer.hpp"
 #include "point_layers.hpp"
 

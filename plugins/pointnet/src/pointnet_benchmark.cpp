@@ -3,9 +3,9 @@
 #include <ctime>
 #include <stdexcept>
 
-#include "c3po/parallel.hpp"
+#include "c3po/base/parallel.hpp"
 #include "c3po/plugins/pointnet.hpp"
-#include "c3po/random.hpp"
+#include "c3po/base/random.hpp"
 
 namespace c3po {
 namespace {

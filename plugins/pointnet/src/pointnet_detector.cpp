@@ -5,8 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "c3po/error.hpp"
-#include "c3po/parallel.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/base/parallel.hpp"
 #include "detector_impl.hpp"
 #include "input_preparation.hpp"
 

@@ -4,8 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/error.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
 #include "detector_impl.hpp"
 #include "model_file.hpp"
 

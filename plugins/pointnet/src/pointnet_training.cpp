@@ -8,9 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "c3po/interrupt.hpp"
-#include "c3po/parallel.hpp"
-#include "c3po/random.hpp"
+#include "c3po/base/interrupt.hpp"
+#include "c3po/base/parallel.hpp"
+#include "c3po/base/random.hpp"
 #include "detector_impl.hpp"
 #include "input_preparation.hpp"
 

@@ -7,9 +7,9 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "c3po/error.hpp"
-#include "c3po/icp.hpp"
-#include "c3po/random.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/method/icp.hpp"
+#include "c3po/base/random.hpp"
 #include "distance_grid.hpp"
 
 namespace c3po {

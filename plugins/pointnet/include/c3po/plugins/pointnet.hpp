@@ -39,8 +39,8 @@
 #include <string>
 #include <vector>
 
-#include "c3po/detector.hpp"
-#include "c3po/object_model.hpp"
+#include "c3po/method/detector.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po {
 

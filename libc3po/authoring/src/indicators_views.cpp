@@ -1,0 +1,216 @@
+// Automatic indicator sets, step 1: render views evenly over the sphere of
+// viewing directions and decide for each whether it pins the pose down (the
+// cover-set condition, paper eq. 20).
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "c3po/method/certificate.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/authoring/indicators.hpp"
+
+namespace c3po {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Fibonacci sphere: direction i of n, evenly spread (golden-angle spiral).
+Eigen::Vector3d FibonacciDirection(int i, int n) {
+  const double z = 1.0 - (2.0 * i + 1.0) / n;
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const double phi = i * kPi * (3.0 - std::sqrt(5.0));
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+// camera_from_model rotation of a camera looking along -direction (model
+// frame), rolled by `roll` about its optical axis.
+Eigen::Matrix3d LookAtRotation(const Eigen::Vector3d& direction, double roll) {
+  const Eigen::Vector3d forward = -direction.normalized();
+  const Eigen::Vector3d helper = std::abs(forward.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
+                                                             : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d x0 = helper.cross(forward).normalized();
+  const Eigen::Vector3d y0 = forward.cross(x0);   // x0 × y0 = forward
+  Eigen::Matrix3d model_from_camera;
+  model_from_camera.col(0) = std::cos(roll) * x0 + std::sin(roll) * y0;
+  model_from_camera.col(1) = -std::sin(roll) * x0 + std::cos(roll) * y0;
+  model_from_camera.col(2) = forward;
+  return model_from_camera.transpose();
+}
+
+// Hausdorff(T1·B̂, T2·B̂) = Hausdorff(B̂, T·B̂), T = T1^-1 T2, with a subsample
+// Q of B̂ as queries and the model tree as targets (no rebuild).
+double PosedModelHausdorff(const ObjectModel& object, const PointSet& queries, const Pose& first,
+                           const Pose& second) {
+  const Pose relative = first.Inverse() * second;
+  const double forward = object.DistancesToPosedModel(relative * queries, Pose::Identity()).maxCoeff();
+  const double backward = object.DistancesToPosedModel(queries, relative).maxCoeff();
+  return std::max(forward, backward);
+}
+
+double MaxDistance(const ObjectModel& object, const PointSet& cloud, const Pose& pose) {
+  return object.DistancesToPosedModel(cloud, pose).maxCoeff();
+}
+
+// Model-frame rotation about `centre`: p -> R (p - c) + c.
+Pose AboutCentre(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& centre) {
+  return {rotation, centre - rotation * centre};
+}
+
+// The 24 rotations of the cube: signed permutation matrices with det +1.
+std::vector<Eigen::Matrix3d> CubeGroup() {
+  std::vector<Eigen::Matrix3d> group;
+  const int permutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (const auto& perm : permutations) {
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+      for (int r = 0; r < 3; ++r) m(r, perm[r]) = (signs >> r) & 1 ? -1.0 : 1.0;
+      if (m.determinant() > 0) group.push_back(m);
+    }
+  }
+  return group;
+}
+
+}  // namespace
+
+void ViewSamplingOptions::Check() const {
+  if (views < 1 || views > 1000000) throw InputError("--views", "must be in [1, 1000000]");
+  if (points < 10) throw InputError("--points", "must be at least 10");
+  if (!std::isfinite(noise_sigma)) throw InputError("--noise", "must be finite");
+  if (!(std::isfinite(distance_min) && std::isfinite(distance_max) && distance_min >= 0 &&
+        distance_max >= distance_min)) {
+    throw InputError("--distance", "need 0 <= min <= max");
+  }
+  if (min_points < 3) throw InputError("min_points", "must be at least 3");
+  camera.Check();
+}
+
+RenderedView RenderView(const ObjectModel& object, const ViewSamplingOptions& options,
+                        double noise_sigma, int index, DepthRenderer* renderer) {
+  const Eigen::AlignedBox3d box = object.mesh().BoundingBox();
+  const Eigen::Vector3d centre = box.center();
+  const double d = object.diameter();
+  double near = options.distance_min, far = options.distance_max;
+  if (near <= 0 && far <= 0) {
+    // As c3po synth: the diameter spans 40 % of the image height at D0.
+    const double d0 = options.camera.fy * d / (0.4 * options.camera.height);
+    near = 0.5 * d0;
+    far = 1.5 * d0;
+  }
+  Rng rng = Rng::ForItem(options.seed, static_cast<std::uint64_t>(index));
+  RenderedView view;
+  view.direction = FibonacciDirection(index % options.views, options.views);
+  DepthSampleOptions sampling;
+  sampling.points = options.points;
+  sampling.noise_sigma = std::max(0.0, noise_sigma);
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    const double roll = rng.Uniform(0.0, 2.0 * kPi);
+    const double distance = rng.Uniform(near, far);
+    Pose camera_from_model;
+    camera_from_model.R = LookAtRotation(view.direction, roll);
+    camera_from_model.t = -(camera_from_model.R * (centre + distance * view.direction));
+    renderer->Render(object.mesh(), camera_from_model);
+    view.camera_from_model = camera_from_model;
+    view.cloud = renderer->SampleCloud(sampling, rng);
+    if (view.cloud.cols() >= options.min_points) break;
+  }
+  return view;
+}
+
+void DegeneracyOptions::Check() const {
+  if (!(std::isfinite(eps_oc) && std::isfinite(delta_nd))) throw InputError("thresholds", "must be finite");
+  if (!(tolerance_factor >= 1.0 && std::isfinite(tolerance_factor))) {
+    throw InputError("--tolerance", "must be at least 1 (times eps_oc)");
+  }
+  if (screening_iterations < 1) throw InputError("screening_iterations", "must be positive");
+  if (!(screening_factor > 0 && std::isfinite(screening_factor))) throw InputError("screening_factor", "must be positive");
+  if (search_points < 10) throw InputError("search_points", "must be at least 10");
+  if (hausdorff_points < 10) throw InputError("hausdorff_points", "must be at least 10");
+  icp.Check();
+}
+
+std::vector<Pose> DegeneracySearchMotions(const ObjectModel& object) {
+  const PointSet& sample = object.sample();
+  const Eigen::Vector3d centroid = sample.rowwise().mean();
+  const PointSet centred = sample.colwise() - centroid;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(centred * centred.transpose());
+  Eigen::Matrix3d axes = pca.eigenvectors();   // principal frame, columns
+  if (axes.determinant() < 0) axes.col(0) = -axes.col(0);
+
+  std::vector<Pose> motions;
+  for (const Eigen::Matrix3d& m : CubeGroup()) {   // the identity comes first
+    motions.push_back(AboutCentre(axes * m * axes.transpose(), centroid));
+  }
+  for (int k = 0; k < 3; ++k) {
+    for (int step : {1, 3, 5, 7}) {
+      const Eigen::AngleAxisd turn(step * kPi / 4.0, axes.col(k));
+      motions.push_back(AboutCentre(turn.toRotationMatrix(), centroid));
+    }
+  }
+  const double shift = 0.25 * object.diameter();
+  for (int k = 0; k < 3; ++k) {
+    for (double sign : {-1.0, 1.0}) motions.push_back({Eigen::Matrix3d::Identity(), sign * shift * axes.col(k)});
+  }
+  return motions;
+}
+
+ViewDegeneracy AnalyzeViewDegeneracy(const ObjectModel& object, const PointSet& cloud,
+                                     const Pose& scene_from_model,
+                                     const std::vector<Pose>& motions,
+                                     const DegeneracyOptions& options) {
+  options.Check();
+  if (!(options.eps_oc > 0 && options.delta_nd > 0)) {
+    throw std::invalid_argument("AnalyzeViewDegeneracy: resolve eps_oc and delta_nd first");
+  }
+  if (object.num_keypoints() > 64) throw InputError(object.name(), "automatic indicator sets support at most 64 keypoints");
+  ViewDegeneracy result;
+  if (cloud.cols() < 3 || !cloud.allFinite()) return result;   // not usable
+  const Eigen::VectorXd keypoint_distances = DistancesToCloud(scene_from_model * object.keypoints(), cloud);
+  for (Eigen::Index i = 0; i < keypoint_distances.size(); ++i) {
+    if (keypoint_distances(i) < options.delta_nd) result.seen_mask |= std::uint64_t{1} << i;
+  }
+  result.true_fit = MaxDistance(object, cloud, scene_from_model);
+  result.usable = result.true_fit < options.eps_oc;
+  if (!result.usable) return result;
+
+  // Starts: model-frame motions composed with the truth, and shifts of the
+  // truth along the viewing ray by fractions of the object's depth extent there.
+  std::vector<Pose> starts;
+  for (const Pose& motion : motions) starts.push_back(scene_from_model * motion);
+  const Eigen::Vector3d ray = cloud.rowwise().mean().normalized();
+  const Eigen::VectorXd depth = ray.transpose() * (scene_from_model * StridedColumns(object.sample(), 2000));
+  const double extent = depth.maxCoeff() - depth.minCoeff();
+  for (double fraction : {-1.0, -0.5, 0.5, 1.0}) {
+    starts.push_back(Pose{Eigen::Matrix3d::Identity(), fraction * extent * ray} * scene_from_model);
+  }
+
+  const PointSet search_cloud = StridedColumns(cloud, options.search_points);
+  const PointSet queries = StridedColumns(object.sample(), options.hausdorff_points);
+  const double tolerance = options.tolerance_factor * options.eps_oc;
+  IcpOptions screening = options.icp;
+  screening.max_iterations = std::min(options.icp.max_iterations, options.screening_iterations);
+  for (const Pose& start : starts) {
+    ++result.starts;
+    // A short first run drops starts that are still far from any fit (an RMS
+    // above the screening factor times eps_oc), then the rest refines.
+    IcpResult icp = RefineIcp(object, search_cloud, start, screening);
+    if (!icp.ok() || !icp.scene_from_model.IsFinite()) continue;
+    if (!icp.converged) {
+      if (icp.rms_after > options.screening_factor * options.eps_oc) continue;
+      icp = RefineIcp(object, search_cloud, icp.scene_from_model, options.icp);
+      if (!icp.ok() || !icp.scene_from_model.IsFinite()) continue;
+    }
+    if (MaxDistance(object, cloud, icp.scene_from_model) >= options.eps_oc) continue;
+    ++result.fitting_starts;
+    const double hausdorff = PosedModelHausdorff(object, queries, scene_from_model, icp.scene_from_model);
+    if (hausdorff > result.worst_hausdorff) {
+      result.worst_hausdorff = hausdorff;
+      result.worst_pose = icp.scene_from_model;
+    }
+    // One far fitting pose settles it; the remaining starts cannot undo it.
+    if (result.worst_hausdorff > tolerance) break;
+  }
+  result.degenerate = result.worst_hausdorff > tolerance;
+  return result;
+}
+
+}  // namespace c3po

@@ -1,0 +1,151 @@
+#pragma once
+// Evaluation on a dataset with ground truth: the rows of the paper's Tables
+// II-IV (Section VIII) for every detector given.
+//
+// For a detector labelled L, on every cloud X with ground truth T*:
+//   "KeyPo (L)"             T(ỹ): registration of the detected keypoints (eq. 8),
+//                           certified like any other output (oc, nd);
+//   "KeyPo (L) + ICP"       point-to-point ICP against X from T(ỹ) (RefineIcp),
+//                           certified with keypoints T·b (agreement check trivial);
+//   "KeyPo (L) + corrector" the corrector (eq. 17) from ỹ, certified.
+// For a self-trained detector (Section VII) the corrector rows are named
+//   "C-3PO (L)", "C-3PO (L) (oc = 1)", "C-3PO (L) (oc = nd = 1)"
+// (all clouds; the observably correct ones; the certified ones).
+//
+// Per sample: ADD-S (the variant is part of the options and named in every
+// output), rotation error, translation error. A pose that could not be
+// estimated (unreadable cloud, detector failure, degenerate keypoints) counts
+// as a failure: ADD-S = +inf, rotation error = pi, translation error = +inf,
+// oc = nd = 0.
+//
+// Soundness: a false certificate is a certified sample whose ADD-S is not
+// below the ADD-S threshold; every row counts them and lists the worst.
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "c3po/io/dataset.hpp"
+#include "c3po/method/detector.hpp"
+#include "c3po/method/icp.hpp"
+#include "c3po/eval/metrics.hpp"
+#include "c3po/object/object_model.hpp"
+#include "c3po/method/pipeline.hpp"
+
+namespace c3po {
+
+struct EvaluationOptions {
+  double adds_threshold = 0.0;     // absolute (object units), e.g. 5 % of d
+  double auc_max = 0.0;            // absolute, upper end of the AUC curve, e.g. 10 % of d
+  AddSVariant adds_variant = AddSVariant::kSymmetric;
+  PipelineOptions pipeline;        // corrector + certificate thresholds (absolute)
+  IcpOptions icp;
+  bool run_icp = true;             // false: no "+ ICP" rows
+  int worst_listed = 5;            // false certificates listed per row
+  void Check() const;              // throws std::invalid_argument
+  // Paper defaults: thresholds 5 % and 10 % of d; certificate thresholds of the object.
+  static EvaluationOptions Defaults(const ObjectModel& object);
+};
+
+// One detector to evaluate.
+struct EvaluatedDetector {
+  std::string label;                   // "sim", "svd", ...
+  const Detector* detector = nullptr;  // nullptr: the manifest's detected_keypoints
+  bool self_trained = false;
+};
+
+enum class EvalMethod { kKeyPo, kKeyPoIcp, kKeyPoCorrector, kC3po };
+enum class EvalSubset { kAll, kObservablyCorrect, kCertified };
+const char* ToString(EvalMethod method);   // "keypo", "keypo+icp", "keypo+corrector", "c3po"
+const char* ToString(EvalSubset subset);   // "all", "oc=1", "oc=nd=1"
+// "KeyPo (sim) + ICP", "C-3PO (real) (oc = nd = 1)", ...
+std::string RowLabel(EvalMethod method, EvalSubset subset, const std::string& detector_label);
+
+struct SampleResult {
+  std::size_t index = 0;               // dataset entry
+  std::string cloud;                   // manifest name of the cloud
+  std::string error;                   // non-empty: no pose (why)
+  Pose scene_from_model;               // estimate T̂
+  PointSet keypoints;                  // output keypoints (corrected, or T̂·b for ICP)
+  PointSet detected_keypoints;         // ỹ
+  double adds = 0.0;                   // object units
+  double rotation_error = 0.0;         // radians
+  double translation_error = 0.0;      // object units
+  bool oc = false;
+  bool nd = false;
+  double oc_distance = 0.0;            // max_x min_p ||x - p|| (evidence of oc)
+  double milliseconds = 0.0;           // estimation + certification time of this method
+  bool ok() const { return error.empty(); }
+  bool certified() const { return oc && nd; }
+};
+
+struct FalseCertificate {
+  std::size_t index = 0;
+  std::string cloud;
+  double adds = 0.0;
+  double rotation_error = 0.0;         // radians
+  double translation_error = 0.0;
+};
+
+struct RowSummary {
+  int n = 0;                           // samples in the row (the subset)
+  int failures = 0;                    // samples without a pose
+  double adds_score = 0.0;             // % with ADD-S < adds_threshold (NaN when n = 0)
+  double adds_auc = 0.0;               // 0..100 (NaN when n = 0)
+  double median_rotation_error = 0.0;  // radians
+  double median_translation_error = 0.0;
+  double median_translation_error_over_d = 0.0;
+  double median_adds = 0.0;
+  double percent_oc = 0.0;
+  double percent_nd = 0.0;
+  double percent_certified = 0.0;
+  int certified = 0;
+  int false_certificates = 0;          // certified with ADD-S >= adds_threshold
+  std::vector<FalseCertificate> worst_false_certificates;   // by ADD-S, descending
+};
+
+struct EvaluationRow {
+  std::string label;                   // RowLabel(...)
+  std::string detector;                // detector label
+  EvalMethod method = EvalMethod::kKeyPo;
+  EvalSubset subset = EvalSubset::kAll;
+  std::vector<SampleResult> samples;   // the samples of the subset, dataset order
+  RowSummary summary;
+};
+
+struct Evaluation {
+  std::string object_name;
+  std::string dataset_dir;
+  std::size_t clouds = 0;
+  double diameter = 0.0;
+  EvaluationOptions options;           // absolute thresholds used
+  std::vector<EvaluationRow> rows;
+  int total_false_certificates() const;
+  // The row whose examples a report shows: the first C-3PO row on all clouds,
+  // else the first corrector row, else the first row; nullptr without rows.
+  const EvaluationRow* MainRow() const;
+};
+
+// Summary statistics of a set of samples (any subset).
+RowSummary Summarize(const std::vector<SampleResult>& samples, const EvaluationOptions& options,
+                     double diameter);
+
+// Runs every detector on every cloud of the dataset (in parallel over clouds)
+// and returns the rows in the order: for each detector, its KeyPo, + ICP,
+// + corrector rows (or its three C-3PO rows when self-trained). Throws
+// InputError("dir/manifest.jsonl: ...") when an entry has no ground-truth pose
+// or, for a manifest detector, no detected_keypoints; std::invalid_argument
+// for bad options. Unreadable clouds and detector failures are per-sample
+// failures. `progress` is called (from worker threads) after each cloud.
+Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
+                    const std::vector<EvaluatedDetector>& detectors,
+                    const EvaluationOptions& options, const ProgressCallback& progress = {});
+
+// The terminal table: aligned columns, one line per row, then the settings
+// (ADD-S variant, thresholds, certificate thresholds) and the soundness figure.
+std::string EvaluationTable(const Evaluation& evaluation);
+// Everything as one JSON document (settings, rows with summaries, per-sample
+// results of the rows on all clouds); non-finite numbers are written as null.
+std::string EvaluationJson(const Evaluation& evaluation);
+
+}  // namespace c3po

@@ -1,0 +1,344 @@
+// Evaluation of the paper's table rows on a dataset with ground truth.
+#include "c3po/eval/evaluation.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "c3po/method/certificate.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/base/interrupt.hpp"
+#include "c3po/base/parallel.hpp"
+
+namespace c3po {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The three estimates of one detector on one cloud, indexed by Stage.
+enum Stage { kRegistration = 0, kIcp = 1, kCorrected = 2, kStages = 3 };
+
+using DetectorResults = std::vector<std::vector<SampleResult>>;   // [stage][cloud]
+
+SampleResult Failure(std::size_t index, const std::string& cloud, const std::string& why) {
+  SampleResult sample;
+  sample.index = index;
+  sample.cloud = cloud;
+  sample.error = why;
+  sample.adds = kInf;
+  sample.rotation_error = M_PI;
+  sample.translation_error = kInf;
+  sample.oc_distance = kInf;
+  return sample;
+}
+
+// Errors of an estimate against the ground truth (a non-finite pose is a failure).
+void ScoreAgainstTruth(const ObjectModel& object, const Pose& truth, const EvaluationOptions& options,
+                       SampleResult* sample) {
+  if (!sample->ok()) return;
+  if (!sample->scene_from_model.IsFinite()) {
+    const SampleResult failed = Failure(sample->index, sample->cloud, "non-finite pose");
+    *sample = failed;
+    return;
+  }
+  sample->adds = AddS(object.tree(), truth, sample->scene_from_model, options.adds_variant);
+  sample->rotation_error = RotationError(sample->scene_from_model.R, truth.R);
+  sample->translation_error = TranslationError(sample->scene_from_model.t, truth.t);
+}
+
+SampleResult FromEstimate(std::size_t index, const std::string& cloud, const PoseEstimate& estimate) {
+  if (!estimate.ok()) {
+    SampleResult failed = Failure(index, cloud, std::string("registration failed: ") +
+                                                    ToString(estimate.correction.registration));
+    failed.detected_keypoints = estimate.detected_keypoints;
+    return failed;
+  }
+  SampleResult sample;
+  sample.index = index;
+  sample.cloud = cloud;
+  sample.scene_from_model = estimate.scene_from_model;
+  sample.keypoints = estimate.keypoints;
+  sample.detected_keypoints = estimate.detected_keypoints;
+  sample.oc = estimate.certificate.oc.passed;
+  sample.nd = estimate.certificate.nd.passed;
+  sample.oc_distance = estimate.certificate.oc.max_point_distance;
+  sample.milliseconds = estimate.milliseconds;
+  return sample;
+}
+
+// "KeyPo + ICP": ICP from the registration, certified with keypoints T·b.
+SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
+                              const SampleResult& registration, const EvaluationOptions& options) {
+  if (!registration.ok()) {
+    SampleResult failed = Failure(registration.index, registration.cloud, registration.error);
+    failed.detected_keypoints = registration.detected_keypoints;
+    return failed;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const IcpResult icp = RefineIcp(object, cloud, registration.scene_from_model, options.icp);
+  if (!icp.ok()) {
+    SampleResult failed = Failure(registration.index, registration.cloud, "icp: " + icp.failure);
+    failed.detected_keypoints = registration.detected_keypoints;
+    return failed;
+  }
+  SampleResult sample = registration;
+  sample.scene_from_model = icp.scene_from_model;
+  sample.keypoints = icp.scene_from_model * object.keypoints();
+  const Certificate certificate = Certify(object, cloud, sample.scene_from_model, sample.keypoints,
+                                          options.pipeline.certificate);
+  sample.oc = certificate.oc.passed;
+  sample.nd = certificate.nd.passed;
+  sample.oc_distance = certificate.oc.max_point_distance;
+  sample.milliseconds = registration.milliseconds +
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return sample;
+}
+
+// Runs one detector's stages on one (loaded) cloud, writing slot `i` of `out`.
+void EvaluateCloud(const ObjectModel& object, const Dataset& dataset, std::size_t i,
+                   const PointSet& cloud, const EvaluatedDetector& detector,
+                   const EvaluationOptions& options, DetectorResults* out) {
+  const DatasetEntry& entry = dataset.entries[i];
+  PointSet detected;
+  try {
+    detected = detector.detector ? detector.detector->Detect(cloud) : *entry.detected_keypoints;
+    if (detected.cols() != object.num_keypoints()) {
+      throw InputError("detector returned " + std::to_string(detected.cols()) +
+                       " keypoints, the object has " + std::to_string(object.num_keypoints()));
+    }
+  } catch (const std::exception& e) {
+    for (int s = 0; s < kStages; ++s) (*out)[s][i] = Failure(i, entry.cloud, std::string("detector: ") + e.what());
+    return;
+  }
+  PipelineOptions pipeline = options.pipeline;
+  if (!detector.self_trained) {
+    pipeline.correct = false;
+    (*out)[kRegistration][i] = FromEstimate(i, entry.cloud, EstimateAndCertify(object, cloud, detected, pipeline));
+    ScoreAgainstTruth(object, *entry.pose, options, &(*out)[kRegistration][i]);
+    if (options.run_icp) {
+      (*out)[kIcp][i] = RefineAndCertify(object, cloud, (*out)[kRegistration][i], options);
+      ScoreAgainstTruth(object, *entry.pose, options, &(*out)[kIcp][i]);
+    }
+  }
+  pipeline.correct = true;
+  (*out)[kCorrected][i] = FromEstimate(i, entry.cloud, EstimateAndCertify(object, cloud, detected, pipeline));
+  ScoreAgainstTruth(object, *entry.pose, options, &(*out)[kCorrected][i]);
+}
+
+void CheckDataset(const Dataset& dataset, const std::vector<EvaluatedDetector>& detectors) {
+  const std::string where = dataset.dir + "/manifest.jsonl";
+  if (dataset.entries.empty()) throw InputError(where, "the dataset has no clouds");
+  const bool needs_manifest_keypoints =
+      std::any_of(detectors.begin(), detectors.end(), [](const EvaluatedDetector& d) { return !d.detector; });
+  for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
+    const DatasetEntry& entry = dataset.entries[i];
+    const std::string line = where + ": line " + std::to_string(i + 1) + " (" + entry.cloud + ")";
+    if (!entry.pose) throw InputError(line, "no ground-truth pose (\"R\", \"t\"): eval needs ground truth");
+    if (needs_manifest_keypoints && !entry.detected_keypoints) {
+      throw InputError(line, "--detector manifest needs \"detected_keypoints\"");
+    }
+  }
+}
+
+EvaluationRow MakeRow(EvalMethod method, EvalSubset subset, const std::string& detector,
+                      std::vector<SampleResult> samples, const EvaluationOptions& options, double diameter) {
+  EvaluationRow row;
+  row.label = RowLabel(method, subset, detector);
+  row.detector = detector;
+  row.method = method;
+  row.subset = subset;
+  row.samples = std::move(samples);
+  row.summary = Summarize(row.samples, options, diameter);
+  return row;
+}
+
+std::vector<SampleResult> Filter(const std::vector<SampleResult>& samples, EvalSubset subset) {
+  std::vector<SampleResult> kept;
+  for (const auto& s : samples) {
+    if (subset == EvalSubset::kAll || (subset == EvalSubset::kObservablyCorrect && s.oc) ||
+        (subset == EvalSubset::kCertified && s.certified())) {
+      kept.push_back(s);
+    }
+  }
+  return kept;
+}
+
+void AppendRows(const EvaluatedDetector& detector, DetectorResults results,
+                const EvaluationOptions& options, double diameter, std::vector<EvaluationRow>* rows) {
+  const std::string& label = detector.label;
+  if (detector.self_trained) {
+    for (EvalSubset subset : {EvalSubset::kAll, EvalSubset::kObservablyCorrect, EvalSubset::kCertified}) {
+      rows->push_back(MakeRow(EvalMethod::kC3po, subset, label, Filter(results[kCorrected], subset),
+                              options, diameter));
+    }
+    return;
+  }
+  rows->push_back(MakeRow(EvalMethod::kKeyPo, EvalSubset::kAll, label, std::move(results[kRegistration]),
+                          options, diameter));
+  if (options.run_icp) {
+    rows->push_back(MakeRow(EvalMethod::kKeyPoIcp, EvalSubset::kAll, label, std::move(results[kIcp]),
+                            options, diameter));
+  }
+  rows->push_back(MakeRow(EvalMethod::kKeyPoCorrector, EvalSubset::kAll, label,
+                          std::move(results[kCorrected]), options, diameter));
+}
+
+double Percent(int count, int n) { return n > 0 ? 100.0 * count / n : kNaN; }
+
+}  // namespace
+
+void EvaluationOptions::Check() const {
+  if (!(adds_threshold > 0) || !std::isfinite(adds_threshold)) {
+    throw std::invalid_argument("EvaluationOptions: adds_threshold must be positive and finite");
+  }
+  if (!(auc_max > 0) || !std::isfinite(auc_max)) {
+    throw std::invalid_argument("EvaluationOptions: auc_max must be positive and finite");
+  }
+  if (worst_listed < 0) throw std::invalid_argument("EvaluationOptions: worst_listed must be >= 0");
+  pipeline.Check();
+  if (run_icp) icp.Check();
+}
+
+EvaluationOptions EvaluationOptions::Defaults(const ObjectModel& object) {
+  EvaluationOptions options;
+  options.adds_threshold = 0.05 * object.diameter();
+  options.auc_max = 0.10 * object.diameter();
+  options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
+  return options;
+}
+
+const char* ToString(EvalMethod method) {
+  switch (method) {
+    case EvalMethod::kKeyPo: return "keypo";
+    case EvalMethod::kKeyPoIcp: return "keypo+icp";
+    case EvalMethod::kKeyPoCorrector: return "keypo+corrector";
+    case EvalMethod::kC3po: return "c3po";
+  }
+  return "?";
+}
+
+const char* ToString(EvalSubset subset) {
+  switch (subset) {
+    case EvalSubset::kAll: return "all";
+    case EvalSubset::kObservablyCorrect: return "oc=1";
+    case EvalSubset::kCertified: return "oc=nd=1";
+  }
+  return "?";
+}
+
+std::string RowLabel(EvalMethod method, EvalSubset subset, const std::string& detector_label) {
+  std::string label;
+  switch (method) {
+    case EvalMethod::kKeyPo: label = "KeyPo (" + detector_label + ")"; break;
+    case EvalMethod::kKeyPoIcp: label = "KeyPo (" + detector_label + ") + ICP"; break;
+    case EvalMethod::kKeyPoCorrector: label = "KeyPo (" + detector_label + ") + corrector"; break;
+    case EvalMethod::kC3po: label = "C-3PO (" + detector_label + ")"; break;
+  }
+  if (subset == EvalSubset::kObservablyCorrect) label += " (oc = 1)";
+  if (subset == EvalSubset::kCertified) label += " (oc = nd = 1)";
+  return label;
+}
+
+int Evaluation::total_false_certificates() const {
+  int total = 0;
+  for (const auto& row : rows) {
+    if (row.subset == EvalSubset::kAll) total += row.summary.false_certificates;
+  }
+  return total;
+}
+
+const EvaluationRow* Evaluation::MainRow() const {
+  for (const auto& row : rows) {
+    if (row.method == EvalMethod::kC3po && row.subset == EvalSubset::kAll) return &row;
+  }
+  for (const auto& row : rows) {
+    if (row.method == EvalMethod::kKeyPoCorrector) return &row;
+  }
+  return rows.empty() ? nullptr : &rows.front();
+}
+
+RowSummary Summarize(const std::vector<SampleResult>& samples, const EvaluationOptions& options,
+                     double diameter) {
+  RowSummary summary;
+  summary.n = static_cast<int>(samples.size());
+  std::vector<double> adds, rotation, translation;
+  int oc = 0, nd = 0;
+  std::vector<FalseCertificate> false_certificates;
+  for (const auto& s : samples) {
+    adds.push_back(s.adds);
+    rotation.push_back(s.rotation_error);
+    translation.push_back(s.translation_error);
+    summary.failures += !s.ok();
+    oc += s.oc;
+    nd += s.nd;
+    summary.certified += s.certified();
+    if (s.certified() && !(s.adds < options.adds_threshold)) {
+      false_certificates.push_back({s.index, s.cloud, s.adds, s.rotation_error, s.translation_error});
+    }
+  }
+  summary.adds_score = ThresholdScore(adds, options.adds_threshold);
+  summary.adds_auc = adds.empty() ? kNaN : AddSAuc(adds, options.auc_max);
+  summary.median_adds = Median(adds);
+  summary.median_rotation_error = Median(rotation);
+  summary.median_translation_error = Median(translation);
+  summary.median_translation_error_over_d = summary.median_translation_error / diameter;
+  summary.percent_oc = Percent(oc, summary.n);
+  summary.percent_nd = Percent(nd, summary.n);
+  summary.percent_certified = Percent(summary.certified, summary.n);
+  summary.false_certificates = static_cast<int>(false_certificates.size());
+  std::stable_sort(false_certificates.begin(), false_certificates.end(),
+                   [](const FalseCertificate& a, const FalseCertificate& b) { return a.adds > b.adds; });
+  if (static_cast<int>(false_certificates.size()) > options.worst_listed) {
+    false_certificates.resize(options.worst_listed);
+  }
+  summary.worst_false_certificates = std::move(false_certificates);
+  return summary;
+}
+
+Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
+                    const std::vector<EvaluatedDetector>& detectors,
+                    const EvaluationOptions& options, const ProgressCallback& progress) {
+  options.Check();
+  if (detectors.empty()) throw std::invalid_argument("Evaluate: no detectors");
+  CheckDataset(dataset, detectors);
+  const std::size_t count = dataset.entries.size();
+  std::vector<DetectorResults> results(detectors.size(),
+                                       DetectorResults(kStages, std::vector<SampleResult>(count)));
+  std::atomic<std::size_t> done{0};
+  ParallelFor(0, static_cast<int>(count), [&](int i) {
+    ThrowIfInterrupted();
+    const std::string& name = dataset.entries[i].cloud;
+    PointSet cloud;
+    std::string load_error;
+    try {
+      cloud = dataset.LoadCloud(i);
+    } catch (const std::exception& e) {
+      load_error = e.what();
+    }
+    for (std::size_t d = 0; d < detectors.size(); ++d) {
+      if (!load_error.empty()) {
+        for (int s = 0; s < kStages; ++s) results[d][s][i] = Failure(i, name, load_error);
+        continue;
+      }
+      EvaluateCloud(object, dataset, i, cloud, detectors[d], options, &results[d]);
+    }
+    if (progress) progress(++done, count);
+  });
+
+  Evaluation evaluation;
+  evaluation.object_name = object.name();
+  evaluation.dataset_dir = dataset.dir;
+  evaluation.clouds = count;
+  evaluation.diameter = object.diameter();
+  evaluation.options = options;
+  for (std::size_t d = 0; d < detectors.size(); ++d) {
+    AppendRows(detectors[d], std::move(results[d]), options, object.diameter(), &evaluation.rows);
+  }
+  return evaluation;
+}
+
+}  // namespace c3po

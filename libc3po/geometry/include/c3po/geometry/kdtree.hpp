@@ -1,0 +1,39 @@
+#pragma once
+// A nanoflann k-d tree over a 3xN point set it owns.
+#include <memory>
+
+#include "c3po/base/types.hpp"
+
+namespace c3po {
+
+class PointTree {
+ public:
+  struct Neighbor {
+    Eigen::Index index = -1;
+    double squared_distance = 0.0;
+  };
+
+  explicit PointTree(PointSet points);
+  ~PointTree();
+  PointTree(PointTree&&) noexcept;
+  PointTree& operator=(PointTree&&) noexcept;
+  PointTree(const PointTree&) = delete;
+  PointTree& operator=(const PointTree&) = delete;
+
+  const PointSet& points() const { return points_; }
+  Eigen::Index size() const { return points_.cols(); }
+
+  Neighbor Nearest(const Eigen::Vector3d& query) const;
+  // k nearest, sorted by distance (k clipped to size()).
+  std::vector<Neighbor> KNearest(const Eigen::Vector3d& query, int k) const;
+  // Nearest neighbour of every column of `queries`, on both cores.
+  void NearestBatch(const PointSet& queries, Eigen::VectorXi* indices,
+                    Eigen::VectorXd* squared_distances) const;
+
+ private:
+  struct Index;
+  PointSet points_;
+  std::unique_ptr<Index> index_;
+};
+
+}  // namespace c3po

@@ -1,0 +1,433 @@
+// Dataset folders: manifest.jsonl (one JSON object per cloud) + cloud files.
+// Reading validates every field; writing builds the dataset in a hidden
+// sibling folder and renames it into place, so readers never see half a
+// dataset.
+#include "c3po/io/dataset.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/io/cloud_io.hpp"
+#include "c3po/base/error.hpp"
+#include "cloud_io_internal.hpp"
+
+namespace c3po {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr double kRotationTolerance = 1e-6;   // max |R^T R - I| accepted
+constexpr double kProjectAbove = 1e-12;       // below this R is kept bit-exact
+constexpr int kMaxJsonDepth = 16;
+
+std::string StripTrailingSlashes(std::string path) {
+  while (path.size() > 1 && path.back() == '/') path.pop_back();
+  return path;
+}
+
+// `text` with control characters replaced, so messages stay on one line.
+std::string Printable(const std::string& text) {
+  std::string printable = text.substr(0, 200);
+  for (char& c : printable) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return printable;
+}
+
+// Why `cloud` is not a safe path inside the dataset folder, or nullopt.
+std::optional<std::string> CloudPathProblem(const std::string& cloud) {
+  if (cloud.empty()) return "empty path";
+  if (cloud.find('\0') != std::string::npos) return "path contains a NUL character";
+  if (cloud.front() == '/') return "absolute path '" + Printable(cloud) + "' (must be relative to the dataset folder)";
+  int depth = 0;
+  std::size_t start = 0;
+  while (start <= cloud.size()) {
+    std::size_t end = cloud.find('/', start);
+    if (end == std::string::npos) end = cloud.size();
+    const std::string part = cloud.substr(start, end - start);
+    if (part == "..") {
+      if (--depth < 0) return "path '" + Printable(cloud) + "' escapes the dataset folder";
+    } else if (!part.empty() && part != ".") {
+      ++depth;
+    }
+    start = end + 1;
+  }
+  if (depth == 0 || cloud.back() == '/') return "path '" + Printable(cloud) + "' does not name a file";
+  return std::nullopt;
+}
+
+// Rejects pathological nesting before handing the text to the JSON parser.
+bool NestingWithin(const std::string& text, int max_depth) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) return false;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return true;
+}
+
+class LineParser {
+ public:
+  LineParser(const nlohmann::json& object, const std::string& where) : object_(object), where_(where) {}
+
+  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
+    throw InputError(where_ + ": " + field + ": " + problem);
+  }
+
+  const nlohmann::json* Find(const char* field) const {
+    const auto it = object_.find(field);
+    return it == object_.end() ? nullptr : &*it;
+  }
+
+  std::string Cloud() const {
+    const nlohmann::json* value = Find("cloud");
+    if (!value) Fail("cloud", "missing (required)");
+    if (!value->is_string()) Fail("cloud", "expected a string");
+    const std::string cloud = value->get<std::string>();
+    if (const auto problem = CloudPathProblem(cloud)) Fail("cloud", *problem);
+    return cloud;
+  }
+
+  double Number(const nlohmann::json& value, const char* field) const {
+    if (!value.is_number()) Fail(field, "expected a number, found " + std::string(value.type_name()));
+    const double number = value.get<double>();
+    if (!std::isfinite(number)) Fail(field, "non-finite number");
+    return number;
+  }
+
+  Eigen::Vector3d Triple(const nlohmann::json& value, const char* field, const std::string& what) const {
+    if (!value.is_array() || value.size() != 3) Fail(field, what + "expected an array of 3 numbers");
+    return {Number(value[0], field), Number(value[1], field), Number(value[2], field)};
+  }
+
+  std::optional<Eigen::Matrix3d> Rotation() const {
+    const nlohmann::json* value = Find("R");
+    if (!value) return std::nullopt;
+    if (!value->is_array() || value->size() != 3) Fail("R", "expected 3 rows of 3 numbers");
+    Eigen::Matrix3d R;
+    for (int r = 0; r < 3; ++r) R.row(r) = Triple((*value)[static_cast<std::size_t>(r)], "R", "row " + std::to_string(r) + ": ").transpose();
+    const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (error > kRotationTolerance) Fail("R", "not orthonormal (max |R^T R - I| = " + std::to_string(error) + ")");
+    if (R.determinant() < 0) Fail("R", "determinant is -1 (a reflection, not a rotation)");
+    if (error > kProjectAbove) {
+      // Nearest rotation in the Frobenius norm: U V^T of the SVD (det stays +1
+      // because R is within 1e-6 of a rotation).
+      const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      R = svd.matrixU() * svd.matrixV().transpose();
+    }
+    return R;
+  }
+
+  std::optional<Eigen::Vector3d> Translation() const {
+    const nlohmann::json* value = Find("t");
+    if (!value) return std::nullopt;
+    return Triple(*value, "t", "");
+  }
+
+  std::optional<PointSet> Points(const char* field) const {
+    const nlohmann::json* value = Find(field);
+    if (!value) return std::nullopt;
+    if (!value->is_array() || value->empty()) Fail(field, "expected a non-empty array of [x, y, z]");
+    PointSet points(3, static_cast<Eigen::Index>(value->size()));
+    for (std::size_t i = 0; i < value->size(); ++i) {
+      points.col(static_cast<Eigen::Index>(i)) = Triple((*value)[i], field, "item " + std::to_string(i) + ": ");
+    }
+    return points;
+  }
+
+  std::optional<std::vector<bool>> Visible() const {
+    const nlohmann::json* value = Find("visible");
+    if (!value) return std::nullopt;
+    if (!value->is_array() || value->empty()) Fail("visible", "expected a non-empty array of booleans");
+    std::vector<bool> visible;
+    for (const auto& item : *value) {
+      if (!item.is_boolean()) Fail("visible", "expected booleans, found " + std::string(item.type_name()));
+      visible.push_back(item.get<bool>());
+    }
+    return visible;
+  }
+
+ private:
+  const nlohmann::json& object_;
+  const std::string& where_;
+};
+
+// Number of keypoints an entry talks about (0 when it has none) and the field
+// that says so; throws if its fields disagree.
+std::pair<std::size_t, const char*> KeypointCount(const DatasetEntry& entry, const std::string& where) {
+  std::size_t count = 0;
+  const char* source = nullptr;
+  const auto agree = [&](std::size_t n, const char* field) {
+    if (source && n != count) {
+      throw InputError(where + ": " + field + ": " + std::to_string(n) + " entries, but " + source +
+                       " has " + std::to_string(count));
+    }
+    count = n;
+    if (!source) source = field;
+  };
+  if (entry.keypoints) agree(static_cast<std::size_t>(entry.keypoints->cols()), "keypoints");
+  if (entry.detected_keypoints) agree(static_cast<std::size_t>(entry.detected_keypoints->cols()), "detected_keypoints");
+  if (entry.visible) agree(entry.visible->size(), "visible");
+  return {count, source};
+}
+
+nlohmann::ordered_json PointsJson(const PointSet& points, const char* field) {
+  if (!points.allFinite()) throw std::invalid_argument(std::string("ManifestLine: non-finite ") + field);
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (Eigen::Index i = 0; i < points.cols(); ++i) rows.push_back({points(0, i), points(1, i), points(2, i)});
+  return rows;
+}
+
+std::string ParentOf(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  return parent.empty() ? "." : parent.string();
+}
+
+std::string LeafOf(const std::string& path) { return fs::path(path).filename().string(); }
+
+bool IsDataset(const std::string& dir) {
+  std::error_code ec;
+  return fs::is_regular_file(fs::path(dir) / "manifest.jsonl", ec);
+}
+
+// Throws unless `dir` is absent, an empty folder or a dataset.
+void CheckReplaceable(const std::string& dir) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(dir, ec);
+  if (!fs::exists(status)) return;
+  if (fs::is_directory(status) && (IsDataset(dir) || fs::is_empty(dir, ec))) return;
+  throw InputError(dir, "exists and is not a c3po dataset (no manifest.jsonl); refusing to overwrite it");
+}
+
+// Flushes every file of the folder's file system to disk (one syncfs instead
+// of an fsync per cloud) and records the folder entries.
+void SyncFileSystemOf(const std::string& folder) {
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::syncfs(fd);
+  ::fsync(fd);
+  ::close(fd);
+}
+
+// Removes ".<name>.partial.<pid>" siblings left by writers that were killed
+// (their process no longer exists); live writers' folders are kept.
+void RemoveStalePartials(const std::string& parent, const std::string& name) {
+  const std::string prefix = "." + name + ".partial.";
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string leaf = it->path().filename().string();
+    if (leaf.rfind(prefix, 0) != 0) continue;
+    const std::string pid_text = leaf.substr(prefix.size());
+    if (pid_text.empty() || pid_text.find_first_not_of("0123456789") != std::string::npos || pid_text.size() > 9) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(pid_text));
+    if (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH) {
+      std::error_code ignored;
+      fs::remove_all(it->path(), ignored);
+    }
+  }
+}
+
+[[noreturn]] void FailWrite(const std::string& path, const std::error_code& ec) {
+  throw InputError(path, "cannot write: " + ec.message());
+}
+
+}  // namespace
+
+std::string Dataset::CloudPath(std::size_t i) const { return dir + "/" + entries.at(i).cloud; }
+
+PointSet Dataset::LoadCloud(std::size_t i) const { return ReadCloud(CloudPath(i)); }
+
+bool Dataset::HasGroundTruth() const {
+  return !entries.empty() && std::all_of(entries.begin(), entries.end(), [](const DatasetEntry& e) {
+           return e.pose.has_value() && e.keypoints.has_value();
+         });
+}
+
+DatasetEntry ParseManifestLine(const std::string& line, const std::string& where) {
+  if (!NestingWithin(line, kMaxJsonDepth)) throw InputError(where + ": JSON nested too deeply");
+  nlohmann::json object;
+  try {
+    object = nlohmann::json::parse(line);
+  } catch (const nlohmann::json::exception& error) {   // parse_error, number overflow
+    std::string message = error.what();
+    const std::size_t bracket = message.find("] ");
+    if (bracket != std::string::npos) message = message.substr(bracket + 2);
+    throw InputError(where + ": not valid JSON: " + message);
+  }
+  if (!object.is_object()) throw InputError(where + ": expected a JSON object");
+  const LineParser parser(object, where);
+  DatasetEntry entry;
+  entry.cloud = parser.Cloud();
+  const auto R = parser.Rotation();
+  const auto t = parser.Translation();
+  if (R.has_value() != t.has_value()) parser.Fail(R ? "t" : "R", "missing (\"R\" and \"t\" go together)");
+  if (R) entry.pose = Pose{*R, *t};
+  entry.keypoints = parser.Points("keypoints");
+  entry.detected_keypoints = parser.Points("detected_keypoints");
+  entry.visible = parser.Visible();
+  KeypointCount(entry, where);
+  return entry;
+}
+
+std::string ManifestLine(const DatasetEntry& entry) {
+  if (const auto problem = CloudPathProblem(entry.cloud)) throw std::invalid_argument("ManifestLine: cloud: " + *problem);
+  nlohmann::ordered_json line;
+  line["cloud"] = entry.cloud;
+  if (entry.pose) {
+    if (!entry.pose->IsFinite()) throw std::invalid_argument("ManifestLine: non-finite pose");
+    const Eigen::Matrix3d& R = entry.pose->R;
+    line["R"] = {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
+    line["t"] = {entry.pose->t.x(), entry.pose->t.y(), entry.pose->t.z()};
+  }
+  if (entry.keypoints) line["keypoints"] = PointsJson(*entry.keypoints, "keypoints");
+  if (entry.detected_keypoints) line["detected_keypoints"] = PointsJson(*entry.detected_keypoints, "detected_keypoints");
+  if (entry.visible) {
+    if (entry.keypoints && static_cast<Eigen::Index>(entry.visible->size()) != entry.keypoints->cols()) {
+      throw std::invalid_argument("ManifestLine: visible and keypoints differ in size");
+    }
+    nlohmann::ordered_json flags = nlohmann::ordered_json::array();
+    for (bool v : *entry.visible) flags.push_back(v);
+    line["visible"] = flags;
+  }
+  return line.dump();
+}
+
+Dataset ReadDataset(const std::string& dir_argument) {
+  const std::string dir = StripTrailingSlashes(dir_argument);
+  std::error_code ec;
+  const fs::file_status status = fs::status(dir, ec);
+  if (!fs::exists(status)) throw InputError(dir, "no such folder");
+  if (!fs::is_directory(status)) throw InputError(dir, "not a folder (expected a dataset folder with manifest.jsonl)");
+  const std::string manifest = dir + "/manifest.jsonl";
+  if (!fs::exists(manifest, ec)) throw InputError(dir, "no manifest.jsonl (not a c3po dataset)");
+  const std::string text = ReadFileToString(manifest);
+
+  Dataset dataset;
+  dataset.dir = dir;
+  std::size_t keypoints = 0, keypoints_line = 0;
+  std::size_t line_number = 0, start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    start = end + 1;
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    const std::string where = manifest + ": line " + std::to_string(line_number);
+    DatasetEntry entry = ParseManifestLine(line, where);
+    const auto [count, field] = KeypointCount(entry, where);
+    if (count > 0 && keypoints > 0 && count != keypoints) {
+      throw InputError(where + ": " + field + ": " + std::to_string(count) + " keypoints, but line " +
+                       std::to_string(keypoints_line) + " has " + std::to_string(keypoints));
+    }
+    if (count > 0 && keypoints == 0) {
+      keypoints = count;
+      keypoints_line = line_number;
+    }
+    if (!fs::is_regular_file(dir + "/" + entry.cloud, ec)) {
+      throw InputError(where + ": cloud: no such file '" + dir + "/" + Printable(entry.cloud) + "'");
+    }
+    dataset.entries.push_back(std::move(entry));
+  }
+  if (dataset.entries.empty()) throw InputError(manifest, "no entries");
+  return dataset;
+}
+
+DatasetWriter::DatasetWriter(std::string dir) : dir_(StripTrailingSlashes(std::move(dir))) {
+  const std::string name = LeafOf(dir_);
+  if (dir_.empty() || name.empty() || name == "." || name == "..") {
+    throw InputError(dir_, "cannot write: not a usable folder name");
+  }
+  CheckReplaceable(dir_);
+  const std::string parent = ParentOf(dir_);
+  std::error_code ec;
+  fs::create_directories(parent, ec);
+  if (ec) FailWrite(dir_, ec);
+  RemoveStalePartials(parent, name);
+  tmp_dir_ = parent + "/." + name + ".partial." + std::to_string(::getpid());
+  fs::remove_all(tmp_dir_, ec);
+  if (!fs::create_directory(tmp_dir_, ec) || ec) FailWrite(dir_, ec ? ec : std::make_error_code(std::errc::file_exists));
+}
+
+DatasetWriter::~DatasetWriter() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove_all(tmp_dir_, ec);
+}
+
+void DatasetWriter::Add(std::size_t order, const DatasetEntry& entry, const PointSet& cloud) {
+  std::string line = ManifestLine(entry);   // validates the entry first
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (committed_) throw std::logic_error("DatasetWriter::Add after Commit");
+    if (!clouds_.insert(entry.cloud).second) {
+      throw std::invalid_argument("DatasetWriter::Add: cloud '" + entry.cloud + "' added twice");
+    }
+  }
+  const std::string path = tmp_dir_ + "/" + entry.cloud;
+  if (entry.cloud.find('/') != std::string::npos) {
+    std::error_code ec;
+    fs::create_directories(ParentOf(path), ec);
+    if (ec) FailWrite(path, ec);
+  }
+  cloud_detail::WritePlyBinary(path, cloud, false);   // synced once by Commit
+  const std::lock_guard<std::mutex> lock(mutex_);
+  lines_.emplace_back(order, std::move(line));
+}
+
+void DatasetWriter::Commit() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (committed_) throw std::logic_error("DatasetWriter::Commit called twice");
+  if (lines_.empty()) throw InputError(dir_, "cannot write: no entries");
+  std::stable_sort(lines_.begin(), lines_.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::string manifest;
+  for (const auto& [order, line] : lines_) manifest += line + "\n";
+  WriteFileAtomically(tmp_dir_ + "/manifest.jsonl", manifest);
+  SyncFileSystemOf(tmp_dir_);   // the clouds were written without fsync
+
+  CheckReplaceable(dir_);
+  std::error_code ec;
+  if (IsDataset(dir_)) {
+    // Swap: old dataset away, new one in, old one deleted.
+    const std::string old_dir = ParentOf(dir_) + "/." + LeafOf(dir_) + ".old." + std::to_string(::getpid());
+    fs::remove_all(old_dir, ec);
+    fs::rename(dir_, old_dir, ec);
+    if (ec) FailWrite(dir_, ec);
+    fs::rename(tmp_dir_, dir_, ec);
+    if (ec) {
+      std::error_code restore;
+      fs::rename(old_dir, dir_, restore);
+      FailWrite(dir_, ec);
+    }
+    fs::remove_all(old_dir, ec);
+  } else {
+    fs::rename(tmp_dir_, dir_, ec);   // also replaces an empty folder
+    if (ec) FailWrite(dir_, ec);
+  }
+  SyncFileSystemOf(ParentOf(dir_));   // make the renames durable
+  committed_ = true;
+}
+
+}  // namespace c3po

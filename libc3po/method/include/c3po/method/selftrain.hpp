@@ -1,0 +1,76 @@
+#pragma once
+// Certificate-gated self-training (paper Section VI-C, Algorithm 1; method.md
+// "Self-supervised"): each batch runs detector -> corrector -> certificates
+// and only observably correct samples contribute, regressed onto their
+// corrected keypoints. In the reference the corrector's backward rule
+// (∂Δy*/∂ỹ = -I) cancels the Chamfer term, so the detector's only signal is
+// "move the detected keypoints toward the fixed corrected keypoints" on
+// certified samples: exactly this regression onto pseudo-labels.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "c3po/method/detector.hpp"
+#include "c3po/object/object_model.hpp"
+#include "c3po/method/pipeline.hpp"
+
+namespace c3po {
+
+struct SelfTrainOptions {
+  int epochs = 20;
+  int batch = 32;
+  double validation_fraction = 0.1;   // held-out part of the unlabelled clouds
+  double stop_at_percent_oc = 99.0;   // early stop on validation % oc
+  PipelineOptions pipeline;           // corrector + certificate thresholds
+  std::uint64_t seed = 0;
+  std::string checkpoint_path;        // written atomically after every epoch ("" = none)
+  void Check() const;
+};
+
+struct SelfTrainEpochLog {
+  int epoch = 0;                      // 1-based
+  double train_percent_oc = 0.0;      // certified fraction of the training batches (before the steps)
+  double validation_percent_oc = 0.0;
+  double validation_percent_certified = 0.0;   // oc and nd
+  double validation_detection_error = 0.0;     // RMS ||ỹ - y*|| on certified validation clouds
+  double loss = 0.0;                  // mean regression loss on certified samples
+  double mean_corrector_iterations = 0.0;
+  int certified_samples = 0;
+  double seconds = 0.0;
+};
+
+struct SelfTrainResult {
+  std::vector<SelfTrainEpochLog> epochs;
+  int best_epoch = 0;                 // 0 = the initial model was best
+  double best_validation_percent_oc = 0.0;
+  double best_validation_detection_error = 0.0;
+  double initial_validation_percent_oc = 0.0;
+  bool stopped_early = false;
+};
+
+using EpochCallback = std::function<void(const SelfTrainEpochLog&)>;
+
+// Self-trains `detector` in place; on return it holds the best weights.
+// Throws InputError when no sample certifies in the first epoch (nothing to
+// learn from). With options.checkpoint_path, `resume` continues from it.
+SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
+                          TrainableDetector& detector, const SelfTrainOptions& options,
+                          const EpochCallback& on_epoch = {}, const ProgressCallback& progress = {},
+                          bool resume = false);
+
+// % of clouds whose detector + corrector output is observably correct, and %
+// certified (oc and nd); optionally the mean corrector iterations.
+struct CertifiedFraction {
+  double percent_oc = 0.0;
+  double percent_certified = 0.0;
+  double mean_iterations = 0.0;
+  // RMS distance between detected and corrected keypoints over the observably
+  // correct clouds: the detector's error against its own pseudo-labels
+  // (ties in % oc are broken by it when keeping the best epoch).
+  double detection_error = 0.0;
+  std::vector<PoseEstimate> estimates;
+};
+CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<PointSet>& clouds,
+                                   const Detector& detector, const PipelineOptions& options);
+
+}  // namespace c3po

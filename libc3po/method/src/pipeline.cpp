@@ -1,0 +1,52 @@
+#include "c3po/method/pipeline.hpp"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "c3po/geometry/registration.hpp"
+
+namespace c3po {
+
+void PipelineOptions::Check() const {
+  if (max_corrector_points < 0) throw std::invalid_argument("max_corrector_points must be >= 0");
+  corrector.Check();
+  certificate.Check();
+}
+
+PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud,
+                                const PointSet& detected_keypoints, const PipelineOptions& options) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  PoseEstimate estimate;
+  estimate.detected_keypoints = detected_keypoints;
+  const PointSet corrector_cloud = StridedColumns(cloud, options.max_corrector_points);
+  if (options.correct) {
+    // The fast solver's restarts are triggered by the threshold actually
+    // certified (a --eps-oc override), not only the object file's.
+    CorrectorOptions corrector = options.corrector;
+    if (corrector.fast_restart_distance < 0 && options.certificate.eps_oc > 0) {
+      corrector.fast_restart_distance = options.certificate.eps_oc;
+    }
+    estimate.correction = CorrectKeypoints(object, corrector_cloud, detected_keypoints, corrector);
+  } else {
+    // Registration only: y* = ỹ, T̂ = T(ỹ).
+    CorrectorOptions no_iterations = options.corrector;
+    no_iterations.solver = CorrectorSolver::kGradientDescent;
+    no_iterations.gd_max_iterations = 0;
+    estimate.correction = CorrectKeypoints(object, corrector_cloud, detected_keypoints, no_iterations);
+  }
+  estimate.keypoints = estimate.correction.keypoints;
+  estimate.scene_from_model = estimate.correction.scene_from_model;
+  if (estimate.ok()) {
+    estimate.certificate = Certify(object, cloud, estimate.scene_from_model, estimate.keypoints,
+                                   options.certificate);
+  } else {
+    estimate.certificate.oc.eps_oc = options.certificate.eps_oc;
+    estimate.certificate.nd.delta_nd = options.certificate.delta_nd;
+  }
+  estimate.milliseconds =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return estimate;
+}
+
+}  // namespace c3po

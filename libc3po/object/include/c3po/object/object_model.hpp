@@ -1,0 +1,80 @@
+#pragma once
+// An object: mesh B, dense surface sample B̂ with a k-d tree in the model frame,
+// diameter d, semantic keypoints b (3xN), indicator sets and certificate
+// thresholds (paper Sections III, V).
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "c3po/geometry/kdtree.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/base/types.hpp"
+
+namespace c3po {
+
+// What an object JSON file says (annotations/README.md documents the schema).
+struct ObjectSpec {
+  int schema_version = 1;
+  std::string name;
+  std::string mesh_path;                 // absolute (resolved) path in memory
+  std::string units = "m";               // "m" or "mm" (of the mesh file)
+  PointSet keypoints;                    // 3 x N, model frame, object units (metres)
+  std::vector<std::string> keypoint_names;            // empty or N
+  std::vector<std::vector<int>> indicator_sets;       // indices into keypoints
+  double eps_oc = 0.0;                   // absolute, object units
+  double delta_nd = 0.0;                 // absolute, object units
+  // Optional metadata written by tools (e.g. measured precision/recall of
+  // automatic indicator sets); kept verbatim as a JSON string.
+  std::string extra_json;
+
+  int num_keypoints() const { return static_cast<int>(keypoints.cols()); }
+  std::string KeypointName(int i) const;   // name or "kp<i>"
+  // Throws InputError("<where>: <field>: problem") on inconsistent content.
+  void Validate(const std::string& where) const;
+};
+
+struct ObjectModelOptions {
+  int sample_size = 10000;     // |B̂|
+  std::uint64_t seed = 0;      // seed of the surface sample
+  void Check() const;
+};
+
+class ObjectModel {
+ public:
+  ObjectModel(ObjectSpec spec, Mesh mesh, const ObjectModelOptions& options = {});
+
+  const ObjectSpec& spec() const { return spec_; }
+  ObjectSpec& mutable_spec() { return spec_; }
+  const std::string& name() const { return spec_.name; }
+  const Mesh& mesh() const { return mesh_; }
+  const PointSet& keypoints() const { return spec_.keypoints; }
+  int num_keypoints() const { return spec_.num_keypoints(); }
+  const PointSet& sample() const { return tree_->points(); }   // B̂, model frame
+  const PointTree& tree() const { return *tree_; }
+  // Unit outward normals of B̂ (of the triangle each sample point lies on).
+  const PointSet& sample_normals() const { return *normals_; }
+  double diameter() const { return diameter_; }
+  // Mean nearest-neighbour spacing of B̂ (an estimate of the sampling density
+  // term eps_s of Theorem 12).
+  double SampleSpacing() const;
+  // Stable hash of the keypoints (and name), for model files.
+  std::string KeypointHash() const;
+
+  // Nearest model-sample point of every scene point under pose T, computed as
+  // queries of R^T (x - t) against the model-frame tree (no per-pose rebuild).
+  void NearestInPosedModel(const PointSet& scene, const Pose& scene_from_model,
+                           Eigen::VectorXi* indices, Eigen::VectorXd* squared_distances) const;
+  // Distances (not squared) of every scene point to the posed model sample.
+  Eigen::VectorXd DistancesToPosedModel(const PointSet& scene, const Pose& scene_from_model) const;
+
+ private:
+  ObjectSpec spec_;
+  Mesh mesh_;
+  std::shared_ptr<const PointTree> tree_;
+  std::shared_ptr<const PointSet> normals_;
+  double diameter_ = 0.0;
+  mutable double spacing_ = -1.0;
+};
+
+}  // namespace c3po
