@@ -7,12 +7,13 @@
 
 #include "bench_registry.hpp"
 #include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/eval/corrector_benchmark.hpp"
 #include "c3po/io/dataset.hpp"
-#include "c3po/base/error.hpp"
 #include "c3po/object/object_io.hpp"
 #include "command.hpp"
-#include "common.hpp"
+#include "options.hpp"
+#include "progress_bar.hpp"
 
 namespace c3po::cli {
 namespace {
@@ -23,8 +24,8 @@ struct CorrectorBenchCommand {
   std::string sigmas = "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1.0";
   double fraction = 0.8;
   std::string solvers = "fast";
-  std::string loss = "mean";
-  std::string eps_oc_text;
+  CorrectorFlags corrector;    // --loss (the solvers are --solvers)
+  ThresholdFlags thresholds;
   std::uint64_t seed = 0;
   int threads = 1;
   int max_clouds = 0;
@@ -89,9 +90,8 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
   options.solvers.clear();
   std::stringstream solver_list(cmd.solvers);
   for (std::string name; std::getline(solver_list, name, ',');) options.solvers.push_back(ParseCorrectorSolver(name));
-  options.corrector.loss = ParsePointCloudLoss(cmd.loss);
-  options.certificate = CertificateOptions::FromObject(object.spec());
-  if (!cmd.eps_oc_text.empty()) options.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
+  options.corrector.loss = ParsePointCloudLoss(cmd.corrector.loss);
+  options.certificate = ResolveThresholds(cmd.thresholds, object);
   options.seed = cmd.seed;
   options.threads = cmd.threads;
   options.max_clouds = cmd.max_clouds;
@@ -145,10 +145,10 @@ void SetupCorrectorBench(CLI::App& parent, std::function<int()>* run) {
   sub->add_option("--sigma", cmd->sigmas, "Comma-separated noise levels sigma (fraction of d)");
   sub->add_option("--fraction", cmd->fraction, "Probability that a keypoint is perturbed");
   sub->add_option("--solvers", cmd->solvers, "Corrector solvers to compare: fast,gd");
-  sub->add_option("--loss", cmd->loss, "Point-cloud loss: mean or max");
-  sub->add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold (default: object's)");
-  sub->add_option("--seed", cmd->seed, "Seed of the perturbations");
-  sub->add_option("--threads", cmd->threads, "Worker threads (1 gives honest per-cloud times)");
+  AddLossOption(*sub, &cmd->corrector.loss);
+  AddThresholdOptions(*sub, &cmd->thresholds, AutoEpsOc::kRefused);
+  AddSeedOption(*sub, &cmd->seed, "of the perturbations");
+  AddThreadsOption(*sub, &cmd->threads, "1 gives honest per-cloud times");
   sub->add_option("--max-clouds", cmd->max_clouds, "Use at most this many clouds (0 = all)");
   sub->add_option("--json", cmd->json_path, "Also write the rows as JSON to this file");
   sub->add_option("--cases", cmd->cases_path,

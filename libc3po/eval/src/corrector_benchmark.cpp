@@ -9,10 +9,10 @@
 
 #include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
-#include "c3po/eval/metrics.hpp"
 #include "c3po/base/parallel.hpp"
-#include "c3po/geometry/registration.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/eval/metrics.hpp"
+#include "c3po/geometry/registration.hpp"
 #include "c3po/synth/synth.hpp"
 
 namespace c3po {

@@ -25,12 +25,12 @@
 #include <string>
 #include <vector>
 
+#include "c3po/eval/metrics.hpp"
 #include "c3po/io/dataset.hpp"
 #include "c3po/method/detector.hpp"
 #include "c3po/method/icp.hpp"
-#include "c3po/eval/metrics.hpp"
-#include "c3po/object/object_model.hpp"
 #include "c3po/method/pipeline.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po {
 

@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
+#include "c3po/base/types.hpp"
 #include "c3po/method/certificate.hpp"
 #include "c3po/object/object_model.hpp"
-#include "c3po/base/types.hpp"
 
 namespace c3po {
 

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "c3po/object/object_model.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po {
 

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "c3po/io/dataset.hpp"
 #include "c3po/eval/evaluation.hpp"
+#include "c3po/io/dataset.hpp"
 #include "c3po/object/object_model.hpp"
 
 namespace c3po {

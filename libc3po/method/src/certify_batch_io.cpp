@@ -1,0 +1,50 @@
+// The JSON lines of `c3po certify` (schema in certify_batch.hpp).
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "c3po/method/certify_batch.hpp"
+
+namespace c3po {
+namespace {
+
+nlohmann::json PointsJson(const PointSet& points) {
+  nlohmann::json list = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < points.cols(); ++i) list.push_back({points(0, i), points(1, i), points(2, i)});
+  return list;
+}
+
+nlohmann::ordered_json FiniteOrNull(double value) {
+  return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
+}
+
+}  // namespace
+
+std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& e) {
+  const Pose& T = e.scene_from_model;
+  nlohmann::ordered_json line;  // keys in the documented order, "cloud" first
+  line["cloud"] = cloud;
+  line["R"] = {{T.R(0, 0), T.R(0, 1), T.R(0, 2)}, {T.R(1, 0), T.R(1, 1), T.R(1, 2)}, {T.R(2, 0), T.R(2, 1), T.R(2, 2)}};
+  line["t"] = {T.t(0), T.t(1), T.t(2)};
+  line["keypoints"] = PointsJson(e.keypoints);
+  line["oc"] = e.certificate.oc.passed;
+  line["nd"] = e.certificate.nd.passed;
+  line["certified"] = e.certified();
+  line["oc_distance"] = FiniteOrNull(e.certificate.oc.max_point_distance);
+  line["keypoint_distance"] = e.certificate.oc.max_keypoint_distance;
+  line["nd_set"] = e.certificate.nd.passing_set;
+  line["nd_set_distances"] = e.certificate.nd.set_worst_distance;
+  line["eps_oc"] = e.certificate.oc.eps_oc;
+  line["delta_nd"] = e.certificate.nd.delta_nd;
+  line["iterations"] = e.correction.iterations;
+  line["cost_before"] = FiniteOrNull(e.correction.cost_before);
+  line["cost_after"] = FiniteOrNull(e.correction.cost_after);
+  line["status"] = ToString(e.correction.registration);
+  line["ms"] = e.milliseconds;
+  return line.dump();
+}
+
+std::string CertifyErrorJsonLine(const std::string& cloud, const std::string& error) {
+  return nlohmann::json{{"cloud", cloud}, {"error", error}}.dump();
+}
+
+}  // namespace c3po
