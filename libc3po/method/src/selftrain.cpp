@@ -126,9 +126,10 @@ struct EpochStats {
 EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clouds,
                     const std::vector<int>& order, TrainableDetector& detector,
                     const SelfTrainOptions& options, const ProgressCallback& progress,
-                    std::size_t progress_offset, std::size_t progress_total) {
+                    std::size_t progress_offset, std::size_t progress_total, int epoch) {
   EpochStats stats;
   for (std::size_t start = 0; start < order.size(); start += options.batch) {
+    HoldForInterruptAt(epoch, static_cast<long long>(start / options.batch));
     ThrowIfInterrupted();
     const std::size_t end = std::min(order.size(), start + options.batch);
     std::vector<PointSet> batch;
@@ -202,7 +203,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     const auto start = std::chrono::steady_clock::now();
     const std::vector<int> order = Shuffled(train, Rng::ForItem(options.seed, epoch));
     const EpochStats stats = RunEpoch(object, clouds, order, detector, options, progress,
-                                      train.size() * (epoch - 1), progress_total);
+                                      train.size() * (epoch - 1), progress_total, epoch);
     const CertifiedFraction held_out = MeasureCertified(object, validation, detector, options.pipeline);
     SelfTrainEpochLog log;
     log.epoch = epoch;
