@@ -8,6 +8,7 @@
 #include "bench_registry.hpp"
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/base/json.hpp"
 #include "c3po/eval/corrector_benchmark.hpp"
 #include "c3po/io/dataset.hpp"
 #include "c3po/object/object_io.hpp"
@@ -33,11 +34,6 @@ struct CorrectorBenchCommand {
   std::string cases_path;
 };
 
-nlohmann::json PointsJson(const PointSet& points) {
-  nlohmann::json columns = nlohmann::json::array();
-  for (Eigen::Index j = 0; j < points.cols(); ++j) columns.push_back({points(0, j), points(1, j), points(2, j)});
-  return columns;
-}
 
 // JSON lines: a header (model sample B̂, keypoints b, corrector options, the
 // clouds' paths), then one line per case, for reruns by other implementations.
@@ -49,15 +45,15 @@ std::string CasesJsonLines(const ObjectModel& object, const Dataset& dataset,
   const CorrectorOptions& c = options.corrector;
   nlohmann::json header = {{"object", object.name()}, {"diameter", object.diameter()},
                            {"eps_oc", options.certificate.eps_oc}, {"clouds", clouds},
-                           {"model_keypoints", PointsJson(object.keypoints())},
-                           {"model_sample", PointsJson(object.sample())},
+                           {"model_keypoints", PointsToJson(object.keypoints())},
+                           {"model_sample", PointsToJson(object.sample())},
                            {"corrector", {{"kappa", c.kappa}, {"theta", c.theta}, {"loss", ToString(c.loss)},
                                           {"gd_step", c.gd_step}, {"gd_max_iterations", c.gd_max_iterations},
                                           {"gd_tolerance", c.gd_tolerance}}}};
   std::string text = header.dump() + "\n";
   for (const auto& one : cases) {
     const nlohmann::json line = {{"sigma", one.sigma}, {"method", one.method}, {"cloud", one.cloud},
-                                 {"detected_keypoints", PointsJson(one.detected_keypoints)},
+                                 {"detected_keypoints", PointsToJson(one.detected_keypoints)},
                                  {"rotation_deg", one.rotation_deg}, {"oc", one.oc},
                                  {"iterations", one.iterations}, {"cost_before", one.cost_before},
                                  {"cost_after", one.cost_after}, {"corrector_ms", one.corrector_ms},

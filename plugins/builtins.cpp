@@ -12,10 +12,17 @@ namespace c3po {
 
 void RegisterBuiltinDetectors() {
 #ifdef C3PO_HAVE_SVD
-  RegisterDetector({"svd", "principal-axes hypotheses refined by ICP (no training)", false},
-                   [](const ObjectModel& object) -> std::unique_ptr<Detector> {
-                     return std::make_unique<SvdDetector>(object);
-                   });
+  // "pca": principal-axes (PCA) rotation hypotheses refined by ICP. "svd" is
+  // the same detector under its first name (scripts use --detector svd).
+  for (const char* name : {"pca", "svd"}) {
+    RegisterDetector({name, std::string(name) == "pca"
+                                ? "PCA rotation hypotheses refined by ICP (no training); alias: svd"
+                                : "the pca detector (its first name)",
+                      false},
+                     [](const ObjectModel& object) -> std::unique_ptr<Detector> {
+                       return std::make_unique<SvdDetector>(object);
+                     });
+  }
 #endif
 #ifdef C3PO_HAVE_POINTNET
   RegisterModelLoader({"pointnet", "PointNet keypoint regressor (tiny-dnn); train with c3po train", true},

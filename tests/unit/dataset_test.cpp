@@ -13,6 +13,7 @@
 #include "c3po/base/random.hpp"
 #include "c3po/io/cloud_io.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/io/dataset_writer.hpp"
 #include "test_helpers.hpp"
 
 namespace fs = std::filesystem;

@@ -13,6 +13,7 @@
 
 #include "c3po/base/random.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/io/dataset_writer.hpp"
 #include "c3po/object/object_model.hpp"
 #include "test_objects.hpp"
 

@@ -35,7 +35,7 @@ double DistanceToSet(const Eigen::Vector3d& q, const PointSet& points) {
   return (points.colwise() - q).colwise().norm().minCoeff();
 }
 
-// oc and nd of an estimate by brute force (method.md "Certificates").
+// oc and nd of an estimate by brute force (docs/method.md "Certificates").
 std::pair<bool, bool> BruteCertificate(const ObjectModel& object, const PointSet& cloud, const Pose& estimate,
                                        const PointSet& keypoints, double eps_oc, double delta_nd) {
   const PointSet posed = estimate * object.sample();

@@ -175,3 +175,19 @@ TEST_CASE("LoadPlugin rejects what is not a c3po plugin, naming the file") {
     CHECK(FindInfo(ListDetectors(), "bad_abi") == nullptr);
   }
 }
+
+TEST_CASE("pca is the training-free detector's name; svd stays an alias of it") {
+  const std::vector<DetectorInfo> infos = ListDetectors();
+  REQUIRE(FindInfo(infos, "pca") != nullptr);
+  REQUIRE(FindInfo(infos, "svd") != nullptr);
+  const ObjectModel object = test::AsymmetricObject(2000);
+  Pose pose;
+  pose.R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  pose.t = Eigen::Vector3d(0.1, -0.2, 0.5);
+  const PointSet cloud = pose * SampleSurface(object.mesh(), 500, 11);
+  const PointSet by_pca = CreateDetector("pca", object)->Detect(cloud);
+  const PointSet by_svd = CreateDetector("svd", object)->Detect(cloud);
+  CHECK((by_pca - by_svd).norm() == 0.0);
+  // Same detector: it finds the pose of this asymmetric object.
+  CHECK((by_pca - pose * object.keypoints()).cwiseAbs().maxCoeff() < 0.05 * object.diameter());
+}

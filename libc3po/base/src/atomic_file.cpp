@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "c3po/base/error.hpp"
+#include "c3po/base/paths.hpp"
 
 namespace c3po {
 namespace {
@@ -63,18 +64,6 @@ class FdStreamBuf : public std::streambuf {
   std::vector<char> buffer_;
   int error_ = 0;
 };
-
-std::string ParentOf(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  if (slash == std::string::npos) return ".";
-  if (slash == 0) return "/";
-  return path.substr(0, slash);
-}
-
-std::string LeafOf(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
 
 // ".name.tmp.<pid>.<counter>" next to `path`.
 std::string TemporarySibling(const std::string& path) {
@@ -168,11 +157,6 @@ std::string ReadFileToString(const std::string& path) {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string StripTrailingSlashes(std::string path) {
-  while (path.size() > 1 && path.back() == '/') path.pop_back();
-  return path;
-}
 
 // Flushes every file of the folder's file system to disk (one syncfs instead
 // of an fsync per file) and records the folder entries.

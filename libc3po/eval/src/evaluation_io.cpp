@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "c3po/base/json.hpp"
 #include "c3po/eval/evaluation.hpp"
 
 namespace c3po {
@@ -119,8 +120,7 @@ json SampleJson(const SampleResult& s) {
   j["ms"] = s.milliseconds;
   if (s.ok()) {
     const Pose& T = s.scene_from_model;
-    j["R"] = {{T.R(0, 0), T.R(0, 1), T.R(0, 2)}, {T.R(1, 0), T.R(1, 1), T.R(1, 2)}, {T.R(2, 0), T.R(2, 1), T.R(2, 2)}};
-    j["t"] = {T.t(0), T.t(1), T.t(2)};
+    SetPoseJson(T, &j);
   }
   return j;
 }

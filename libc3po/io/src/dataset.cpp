@@ -1,7 +1,6 @@
 // Dataset folders: manifest.jsonl (one JSON object per cloud) + cloud files.
-// Reading validates every field; writing builds the dataset in a hidden
-// sibling folder and renames it into place, so readers never see half a
-// dataset.
+// Reading validates every field. The manifest line schema (ParseManifestLine,
+// ManifestLine) lives here; DatasetWriter is dataset_writer.cpp.
 #include "c3po/io/dataset.hpp"
 
 #include <Eigen/SVD>
@@ -14,8 +13,9 @@
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/base/json.hpp"
+#include "c3po/base/paths.hpp"
 #include "c3po/io/cloud_io.hpp"
-#include "cloud_io_internal.hpp"
 
 namespace c3po {
 namespace fs = std::filesystem;
@@ -24,11 +24,6 @@ namespace {
 constexpr double kRotationTolerance = 1e-6;   // max |R^T R - I| accepted
 constexpr double kProjectAbove = 1e-12;       // below this R is kept bit-exact
 constexpr int kMaxJsonDepth = 16;
-
-std::string StripTrailingSlashes(std::string path) {
-  while (path.size() > 1 && path.back() == '/') path.pop_back();
-  return path;
-}
 
 // `text` with control characters replaced, so messages stay on one line.
 std::string Printable(const std::string& text) {
@@ -188,18 +183,7 @@ std::pair<std::size_t, const char*> KeypointCount(const DatasetEntry& entry, con
 
 nlohmann::ordered_json PointsJson(const PointSet& points, const char* field) {
   if (!points.allFinite()) throw std::invalid_argument(std::string("ManifestLine: non-finite ") + field);
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  for (Eigen::Index i = 0; i < points.cols(); ++i) rows.push_back({points(0, i), points(1, i), points(2, i)});
-  return rows;
-}
-
-std::string ParentOf(const std::string& path) {
-  const fs::path parent = fs::path(path).parent_path();
-  return parent.empty() ? "." : parent.string();
-}
-
-[[noreturn]] void FailWrite(const std::string& path, const std::error_code& ec) {
-  throw InputError(path, "cannot write: " + ec.message());
+  return PointsToJson<nlohmann::ordered_json>(points);
 }
 
 }  // namespace
@@ -246,9 +230,7 @@ std::string ManifestLine(const DatasetEntry& entry) {
   line["cloud"] = entry.cloud;
   if (entry.pose) {
     if (!entry.pose->IsFinite()) throw std::invalid_argument("ManifestLine: non-finite pose");
-    const Eigen::Matrix3d& R = entry.pose->R;
-    line["R"] = {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
-    line["t"] = {entry.pose->t.x(), entry.pose->t.y(), entry.pose->t.z()};
+    SetPoseJson(*entry.pose, &line);
   }
   if (entry.keypoints) line["keypoints"] = PointsJson(*entry.keypoints, "keypoints");
   if (entry.detected_keypoints) line["detected_keypoints"] = PointsJson(*entry.detected_keypoints, "detected_keypoints");
@@ -303,44 +285,6 @@ Dataset ReadDataset(const std::string& dir_argument) {
   }
   if (dataset.entries.empty()) throw InputError(manifest, "no entries");
   return dataset;
-}
-
-DatasetWriter::DatasetWriter(std::string dir)
-    : folder_(std::move(dir), "manifest.jsonl", "c3po dataset") {}
-
-DatasetWriter::~DatasetWriter() = default;
-
-void DatasetWriter::Add(std::size_t order, const DatasetEntry& entry, const PointSet& cloud) {
-  std::string line = ManifestLine(entry);   // validates the entry first
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (committed_) throw std::logic_error("DatasetWriter::Add after Commit");
-    if (!clouds_.insert(entry.cloud).second) {
-      throw std::invalid_argument("DatasetWriter::Add: cloud '" + entry.cloud + "' added twice");
-    }
-  }
-  const std::string path = folder_.path() + "/" + entry.cloud;
-  if (entry.cloud.find('/') != std::string::npos) {
-    std::error_code ec;
-    fs::create_directories(ParentOf(path), ec);
-    if (ec) FailWrite(path, ec);
-  }
-  cloud_detail::WritePlyBinary(path, cloud, false);   // synced once by Commit
-  const std::lock_guard<std::mutex> lock(mutex_);
-  lines_.emplace_back(order, std::move(line));
-}
-
-void DatasetWriter::Commit() {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  if (committed_) throw std::logic_error("DatasetWriter::Commit called twice");
-  if (lines_.empty()) throw InputError(folder_.dir(), "cannot write: no entries");
-  std::stable_sort(lines_.begin(), lines_.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::string manifest;
-  for (const auto& [order, line] : lines_) manifest += line + "\n";
-  WriteFileAtomically(folder_.path() + "/manifest.jsonl", manifest);
-  folder_.Commit();   // syncs the clouds, written without fsync, once
-  committed_ = true;
 }
 
 }  // namespace c3po

@@ -17,17 +17,6 @@ namespace {
 
 constexpr double kMadToSigma = 1.4826;   // sigma / MAD of a Gaussian
 
-PointSet FinitePoints(const PointSet& cloud, int max_points) {
-  std::vector<Eigen::Index> keep;
-  for (Eigen::Index i = 0; i < cloud.cols(); ++i) {
-    if (cloud.col(i).allFinite()) keep.push_back(i);
-  }
-  const std::size_t count = max_points > 0 ? std::min<std::size_t>(keep.size(), max_points) : keep.size();
-  PointSet out(3, static_cast<Eigen::Index>(count));
-  for (std::size_t j = 0; j < count; ++j) out.col(j) = cloud.col(keep[j * keep.size() / count]);
-  return out;
-}
-
 // Offset of `point` from the quadric height field fitted (least squares) to
 // its neighbours in their PCA frame (normal = least-variance axis):
 //   h = a u^2 + b uv + c v^2 + d u + e v + f.
@@ -68,7 +57,7 @@ double QuadricResidual(const PointSet& patch, const Eigen::Vector3d& point) {
 // their k nearest neighbours (the point itself excluded).
 std::vector<double> SurfaceResiduals(const PointSet& cloud, int k, int max_points) {
   std::vector<double> residuals;
-  const PointSet all = FinitePoints(cloud, 0);
+  const PointSet all = FiniteColumns(cloud);
   if (all.cols() < k + 1) return residuals;
   const PointTree tree(all);
   const Eigen::Index stride = std::max<Eigen::Index>(1, all.cols() / std::max(1, max_points));

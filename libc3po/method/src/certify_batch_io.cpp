@@ -2,16 +2,11 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "c3po/base/json.hpp"
 #include "c3po/method/certify_batch.hpp"
 
 namespace c3po {
 namespace {
-
-nlohmann::json PointsJson(const PointSet& points) {
-  nlohmann::json list = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < points.cols(); ++i) list.push_back({points(0, i), points(1, i), points(2, i)});
-  return list;
-}
 
 nlohmann::ordered_json FiniteOrNull(double value) {
   return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
@@ -23,9 +18,8 @@ std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& e) {
   const Pose& T = e.scene_from_model;
   nlohmann::ordered_json line;  // keys in the documented order, "cloud" first
   line["cloud"] = cloud;
-  line["R"] = {{T.R(0, 0), T.R(0, 1), T.R(0, 2)}, {T.R(1, 0), T.R(1, 1), T.R(1, 2)}, {T.R(2, 0), T.R(2, 1), T.R(2, 2)}};
-  line["t"] = {T.t(0), T.t(1), T.t(2)};
-  line["keypoints"] = PointsJson(e.keypoints);
+  SetPoseJson(T, &line);
+  line["keypoints"] = PointsToJson(e.keypoints);
   line["oc"] = e.certificate.oc.passed;
   line["nd"] = e.certificate.nd.passed;
   line["certified"] = e.certified();

@@ -18,18 +18,6 @@ double RotationAngleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) 
   return std::atan2(0.5 * axis.norm(), 0.5 * (delta.trace() - 1.0));
 }
 
-PointSet FiniteColumns(const PointSet& points) {
-  std::vector<Eigen::Index> keep;
-  keep.reserve(points.cols());
-  for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    if (points.col(i).allFinite()) keep.push_back(i);
-  }
-  if (static_cast<Eigen::Index>(keep.size()) == points.cols()) return points;
-  PointSet finite(3, static_cast<Eigen::Index>(keep.size()));
-  for (std::size_t k = 0; k < keep.size(); ++k) finite.col(k) = points.col(keep[k]);
-  return finite;
-}
-
 // Nearest model-sample point of every scene point under `pose`.
 struct Correspondences {
   Eigen::VectorXi model_index;

@@ -9,6 +9,7 @@
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/base/json.hpp"
 
 namespace c3po {
 namespace {
@@ -74,11 +75,7 @@ std::vector<std::vector<int>> ParseIndicatorSets(const json& value, const std::s
 }
 
 json PointListJson(const PointSet& points) {
-  json list = json::array();
-  for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    list.push_back({points(0, i), points(1, i), points(2, i)});
-  }
-  return list;
+  return PointsToJson(points);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "c3po/base/interrupt.hpp"
 #include "c3po/base/parallel.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/io/dataset_writer.hpp"
 #include "c3po/synth/synth.hpp"
 
 namespace c3po {

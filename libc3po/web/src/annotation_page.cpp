@@ -1,5 +1,6 @@
-// The self-contained annotation page: data (object + mesh as base64 typed
-// arrays) and three.js are inlined into the page template (annotation_page_html.cpp).
+// The self-contained annotation page: its static parts
+// (libc3po/web/resources/annotation_page.*), three.js and the data (object +
+// mesh as base64 typed arrays) inlined into one HTML file.
 #include "c3po/web/annotation_page.hpp"
 
 #include <cstdint>
@@ -8,34 +9,18 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "annotation_page_html.hpp"
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/base/json.hpp"
 #include "embedded_resources.hpp"
+#include "three_js.hpp"
+#include "web_text.hpp"
 
 namespace c3po {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-std::string Base64(const unsigned char* bytes, std::size_t size) {
-  static const char kAlphabet[] =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((size + 2) / 3 * 4);
-  for (std::size_t i = 0; i < size; i += 3) {
-    const std::uint32_t b0 = bytes[i];
-    const std::uint32_t b1 = i + 1 < size ? bytes[i + 1] : 0;
-    const std::uint32_t b2 = i + 2 < size ? bytes[i + 2] : 0;
-    const std::uint32_t triple = (b0 << 16) | (b1 << 8) | b2;
-    out += kAlphabet[(triple >> 18) & 63];
-    out += kAlphabet[(triple >> 12) & 63];
-    out += i + 1 < size ? kAlphabet[(triple >> 6) & 63] : '=';
-    out += i + 2 < size ? kAlphabet[triple & 63] : '=';
-  }
-  return out;
-}
 
 // Little-endian float32 xyz per vertex (the page decodes with a DataView).
 std::string VerticesBase64(const Mesh& mesh) {
@@ -47,7 +32,7 @@ std::string VerticesBase64(const Mesh& mesh) {
     std::memcpy(&bits, &value, 4);
     for (int b = 0; b < 4; ++b) bytes.push_back(static_cast<unsigned char>(bits >> (8 * b)));
   }
-  return Base64(bytes.data(), bytes.size());
+  return web::Base64(bytes.data(), bytes.size());
 }
 
 // Little-endian uint32 vertex indices, three per triangle.
@@ -58,7 +43,7 @@ std::string TrianglesBase64(const Mesh& mesh) {
     const auto index = static_cast<std::uint32_t>(mesh.triangles.data()[i]);
     for (int b = 0; b < 4; ++b) bytes.push_back(static_cast<unsigned char>(index >> (8 * b)));
   }
-  return Base64(bytes.data(), bytes.size());
+  return web::Base64(bytes.data(), bytes.size());
 }
 
 // The mesh path as the object JSON names it (relative to the JSON's folder).
@@ -74,11 +59,7 @@ json ObjectJson(const ObjectSpec& spec, const std::string& mesh_reference) {
   object["name"] = spec.name;
   object["mesh"] = mesh_reference;
   object["units"] = spec.units;
-  json keypoints = json::array();
-  for (Eigen::Index i = 0; i < spec.keypoints.cols(); ++i) {
-    keypoints.push_back({spec.keypoints(0, i), spec.keypoints(1, i), spec.keypoints(2, i)});
-  }
-  object["keypoints"] = keypoints;
+  object["keypoints"] = PointsToJson(spec.keypoints);
   json names = json::array();
   for (int i = 0; i < spec.num_keypoints(); ++i) {
     names.push_back(spec.keypoint_names.empty() ? std::string() : spec.keypoint_names[i]);
@@ -89,28 +70,6 @@ json ObjectJson(const ObjectSpec& spec, const std::string& mesh_reference) {
   object["delta_nd"] = spec.delta_nd;
   if (!spec.extra_json.empty()) object["extra"] = json::parse(spec.extra_json);
   return object;
-}
-
-// JSON safe inside <script>: "</" cannot close the element once written "<\/".
-std::string ScriptSafe(std::string text) {
-  for (std::size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) {
-    text.replace(at, 2, "<\\/");
-  }
-  return text;
-}
-
-std::string HtmlEscape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 }  // namespace
@@ -127,16 +86,21 @@ std::string AnnotationPageHtml(const ObjectSpec& spec, const Mesh& mesh,
   data["vertices_f32"] = VerticesBase64(mesh);
   data["triangles_u32"] = TrianglesBase64(mesh);
 
-  const std::string three = resources::ThreeJsModule();
-  if (three.find("</script") != std::string::npos) {
-    throw std::logic_error("embedded three.js contains </script");
-  }
+  const std::string three = web::ThreeJsForPage();
   std::string page;
-  page += page::Head(HtmlEscape(spec.name));
+  page += R"page(<!doctype html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<link rel="icon" href="data:,">
+<title>c3po annotate: )page" + web::HtmlEscape(spec.name) + "</title>\n";
+  page += "<style>\n" + resources::AnnotationPageCss() + "</style>\n</head>\n<body>\n";
+  page += resources::AnnotationPageBody();
   page += "<script type=\"text/plain\" id=\"c3po-three\">" + three + "</script>\n";
-  page += "<script type=\"application/json\" id=\"c3po-data\">" + ScriptSafe(data.dump()) +
+  page += "<script type=\"application/json\" id=\"c3po-data\">" + web::ScriptSafe(data.dump()) +
           "</script>\n";
-  page += page::AppScript();
+  page += "<script type=\"module\">\n" + resources::AnnotationPageJs() + "</script>\n";
   page += "</body>\n</html>\n";
   return page;
 }

@@ -13,14 +13,15 @@
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 #include "embedded_resources.hpp"
-#include "report_page.hpp"
 #include "report_svg.hpp"
+#include "three_js.hpp"
+#include "web_text.hpp"
 
 namespace c3po {
 namespace {
 
 using nlohmann::json;
-using svg::Escape;
+using web::HtmlEscape;
 
 constexpr double kDegrees = 180.0 / M_PI;
 const char* const kPalette[] = {"#4363d8", "#e6194b", "#3cb44b", "#f58231", "#911eb4", "#42d4f4",
@@ -39,62 +40,13 @@ json JsonNumber(double value) { return std::isfinite(value) ? json(value) : json
 
 // ---- 3D view data: little-endian float32 xyz, base64 ----
 
-std::string Base64(const std::vector<unsigned char>& bytes) {
-  static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((bytes.size() + 2) / 3 * 4);
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const std::uint32_t b0 = bytes[i];
-    const std::uint32_t b1 = i + 1 < bytes.size() ? bytes[i + 1] : 0;
-    const std::uint32_t b2 = i + 2 < bytes.size() ? bytes[i + 2] : 0;
-    const std::uint32_t triple = (b0 << 16) | (b1 << 8) | b2;
-    out += kAlphabet[(triple >> 18) & 63];
-    out += kAlphabet[(triple >> 12) & 63];
-    out += i + 1 < bytes.size() ? kAlphabet[(triple >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? kAlphabet[triple & 63] : '=';
-  }
-  return out;
-}
-
-// Finite points only (a NaN would break the view's bounding sphere).
-std::string PointsBase64(const PointSet& points) {
-  std::vector<unsigned char> bytes;
-  bytes.reserve(static_cast<std::size_t>(points.size()) * 4);
-  for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    if (!points.col(i).allFinite()) continue;
-    for (int k = 0; k < 3; ++k) {
-      const float value = static_cast<float>(points(k, i));
-      std::uint32_t bits;
-      std::memcpy(&bits, &value, 4);
-      for (int b = 0; b < 4; ++b) bytes.push_back(static_cast<unsigned char>(bits >> (8 * b)));
-    }
-  }
-  return Base64(bytes);
-}
-
-PointSet Subsample(const PointSet& points, int max_points) {
-  if (points.cols() <= max_points) return points;
-  const Eigen::Index stride = (points.cols() + max_points - 1) / max_points;
-  PointSet kept(3, (points.cols() + stride - 1) / stride);
-  for (Eigen::Index i = 0, j = 0; i < points.cols(); i += stride, ++j) kept.col(j) = points.col(i);
-  return kept;
-}
-
 json ViewJson(const ReportView& v) {
   return {{"title", v.title}, {"cloud", v.cloud}, {"row", v.row}, {"certified", v.certified},
           {"false_certificate", v.false_certificate}, {"adds", JsonNumber(v.adds)},
           {"rotation_error_deg", JsonNumber(v.rotation_error * kDegrees)},
-          {"oc_distance", JsonNumber(v.oc_distance)}, {"input", PointsBase64(v.input)},
-          {"posed_model", PointsBase64(v.posed_model)}, {"truth_model", PointsBase64(v.truth_model)},
-          {"keypoints", PointsBase64(v.keypoints)}, {"detected_keypoints", PointsBase64(v.detected_keypoints)}};
-}
-
-// JSON safe inside <script>: "</" written "<\/" cannot close the element.
-std::string ScriptSafe(std::string text) {
-  for (std::size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) {
-    text.replace(at, 2, "<\\/");
-  }
-  return text;
+          {"oc_distance", JsonNumber(v.oc_distance)}, {"input", web::PointsFloat32Base64(v.input)},
+          {"posed_model", web::PointsFloat32Base64(v.posed_model)}, {"truth_model", web::PointsFloat32Base64(v.truth_model)},
+          {"keypoints", web::PointsFloat32Base64(v.keypoints)}, {"detected_keypoints", web::PointsFloat32Base64(v.detected_keypoints)}};
 }
 
 // ---- page sections ----
@@ -130,7 +82,7 @@ std::string TableHtml(const Evaluation& e) {
       << "<th>t error / d</th><th>% oc</th><th>% nd</th><th>% certified</th><th>false cert.</th></tr></thead>\n<tbody>\n";
   for (const auto& row : e.rows) {
     const RowSummary& s = row.summary;
-    out << "<tr" << (row.subset != EvalSubset::kAll ? " class=\"subset\"" : "") << "><td>" << Escape(row.label)
+    out << "<tr" << (row.subset != EvalSubset::kAll ? " class=\"subset\"" : "") << "><td>" << HtmlEscape(row.label)
         << "</td><td>" << s.n << "</td><td>" << Number("%.1f", s.adds_score) << "</td><td>"
         << Number("%.1f", s.adds_auc) << "</td><td>" << Number("%.2f", s.median_rotation_error * kDegrees)
         << "</td><td>" << Number("%.4f", s.median_translation_error_over_d) << "</td><td>"
@@ -152,10 +104,10 @@ std::string SoundnessHtml(const Evaluation& e) {
       << e.clouds << " clouds.</p>\n";
   for (const auto& row : e.rows) {
     if (row.subset != EvalSubset::kAll || row.summary.false_certificates == 0) continue;
-    out << "<p>" << Escape(row.label) << ": " << row.summary.false_certificates << " of "
+    out << "<p>" << HtmlEscape(row.label) << ": " << row.summary.false_certificates << " of "
         << row.summary.certified << " certified. Worst:</p>\n<ul>\n";
     for (const auto& f : row.summary.worst_false_certificates) {
-      out << "<li><code>" << Escape(f.cloud) << "</code>: ADD-S " << Number("%.4g", f.adds) << ", rotation error "
+      out << "<li><code>" << HtmlEscape(f.cloud) << "</code>: ADD-S " << Number("%.4g", f.adds) << ", rotation error "
           << Number("%.1f", f.rotation_error * kDegrees) << " deg, translation error "
           << Number("%.4g", f.translation_error) << "</li>\n";
     }
@@ -305,7 +257,7 @@ std::string TrainingHtml(const std::vector<TrainingLog>& logs) {
   out << "<section id=\"training\">\n<h2>Training curves</h2>\n";
   if (logs.empty()) out << "<p class=\"note\">No training logs given (<code>--training-log FILE</code>).</p>\n";
   for (const auto& log : logs) {
-    out << "<h3>" << Escape(log.label) << " <span class=\"note\">(" << Escape(log.path) << ", "
+    out << "<h3>" << HtmlEscape(log.label) << " <span class=\"note\">(" << HtmlEscape(log.path) << ", "
         << log.epochs.size() << " epochs)</span></h3>\n<div class=\"charts\">\n"
         << TrainingChart(log, false) << TrainingChart(log, true) << "</div>\n";
   }
@@ -400,8 +352,8 @@ std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Datas
       view.adds = s->adds;
       view.rotation_error = s->rotation_error;
       view.oc_distance = s->oc_distance;
-      view.input = Subsample(cloud, options.max_points);
-      const PointSet model = Subsample(object.sample(), options.max_points);
+      view.input = StridedColumns(cloud, options.max_points);
+      const PointSet model = StridedColumns(object.sample(), options.max_points);
       view.posed_model = s->scene_from_model * model;
       const auto& truth = dataset.entries[s->index].pose;
       if (truth) view.truth_model = *truth * model;
@@ -418,25 +370,24 @@ std::string ReportHtml(const ReportInput& input) {
   const Evaluation& e = *input.evaluation;
   json views = json::array();
   for (const auto& view : input.views) views.push_back(ViewJson(view));
-  const std::string three = input.views.empty() ? std::string() : resources::ThreeJsModule();
-  if (three.find("</script") != std::string::npos) throw std::logic_error("embedded three.js contains </script");
+  const std::string three = input.views.empty() ? std::string() : web::ThreeJsForPage();
 
   std::ostringstream page;
   page << "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
        << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-       << "<link rel=\"icon\" href=\"data:,\">\n<title>" << Escape(input.title + ": " + e.object_name)
-       << "</title>\n" << report_page::Style() << "</head>\n<body>\n";
-  page << "<h1>" << Escape(input.title) << ": " << Escape(e.object_name) << "</h1>\n<p class=\"meta\">Dataset <code>"
-       << Escape(e.dataset_dir) << "</code>, " << e.clouds << " clouds, object diameter d = "
+       << "<link rel=\"icon\" href=\"data:,\">\n<title>" << HtmlEscape(input.title + ": " + e.object_name)
+       << "</title>\n<style>\n" << resources::ReportCss() << "</style>\n</head>\n<body>\n";
+  page << "<h1>" << HtmlEscape(input.title) << ": " << HtmlEscape(e.object_name) << "</h1>\n<p class=\"meta\">Dataset <code>"
+       << HtmlEscape(e.dataset_dir) << "</code>, " << e.clouds << " clouds, object diameter d = "
        << Number("%.4g", e.diameter) << ".";
-  if (!input.command_line.empty()) page << "<br>Command: <code>" << Escape(input.command_line) << "</code>";
+  if (!input.command_line.empty()) page << "<br>Command: <code>" << HtmlEscape(input.command_line) << "</code>";
   page << "</p>\n" << SoundnessHtml(e) << "<section id=\"table\">\n<h2>Results</h2>\n" << TableHtml(e)
        << SettingsHtml(e) << "</section>\n" << AddsPlotsHtml(e) << TrainingHtml(input.training)
        << ViewsHtml(input.views);
   page << "<script type=\"text/plain\" id=\"c3po-three\">" << three << "</script>\n";
   page << "<script type=\"application/json\" id=\"c3po-views\">"
-       << ScriptSafe(json{{"views", views}}.dump()) << "</script>\n";
-  page << report_page::ViewScript() << "</body>\n</html>\n";
+       << web::ScriptSafe(json{{"views", views}}.dump()) << "</script>\n";
+  page << "<script type=\"module\">\n" << resources::ReportViewJs() << "</script>\n</body>\n</html>\n";
   return page.str();
 }
 

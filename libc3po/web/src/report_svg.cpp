@@ -7,6 +7,8 @@
 #include <functional>
 #include <sstream>
 
+#include "web_text.hpp"
+
 namespace c3po::svg {
 namespace {
 
@@ -72,10 +74,10 @@ void DrawAxes(const LineChart& chart, const Frame& f, const Axes& axes, std::ost
         << "\" text-anchor=\"end\">" << ShortNumber(y) << "</text>\n";
   }
   out << "<text x=\"" << (f.left + f.right) / 2 << "\" y=\"" << f.bottom + 30
-      << "\" text-anchor=\"middle\">" << Escape(chart.x_label) << "</text>\n";
+      << "\" text-anchor=\"middle\">" << web::HtmlEscape(chart.x_label) << "</text>\n";
   out << "<text x=\"12\" y=\"" << (f.top + f.bottom) / 2 << "\" text-anchor=\"middle\" transform=\"rotate(-90 12 "
-      << (f.top + f.bottom) / 2 << ")\">" << Escape(chart.y_label) << "</text>\n";
-  out << "<text x=\"" << f.left << "\" y=\"16\" font-weight=\"600\">" << Escape(chart.title) << "</text>\n";
+      << (f.top + f.bottom) / 2 << ")\">" << web::HtmlEscape(chart.y_label) << "</text>\n";
+  out << "<text x=\"" << f.left << "\" y=\"16\" font-weight=\"600\">" << web::HtmlEscape(chart.title) << "</text>\n";
 }
 
 void DrawMarkers(const std::vector<Marker>& markers, double x_min, double x_max, const Frame& f,
@@ -86,7 +88,7 @@ void DrawMarkers(const std::vector<Marker>& markers, double x_min, double x_max,
     out << "<line x1=\"" << x << "\" x2=\"" << x << "\" y1=\"" << f.top << "\" y2=\"" << f.bottom
         << "\" stroke=\"#c00\" stroke-dasharray=\"4 3\"/>"
         << "<text x=\"" << x << "\" y=\"" << f.top - 3 << "\" text-anchor=\"middle\" fill=\"#c00\">"
-        << Escape(m.label) << "</text>\n";
+        << web::HtmlEscape(m.label) << "</text>\n";
   }
 }
 
@@ -104,7 +106,7 @@ void DrawSeries(const LineChart& chart, const Axes& axes, std::ostringstream& ou
     }
     out << "<polyline fill=\"none\" stroke=\"" << s.colour << "\" stroke-width=\"1.8\""
         << (s.dashed ? " stroke-dasharray=\"6 3\"" : "") << " points=\"" << points.str() << "\">"
-        << "<title>" << Escape(s.name) << "</title></polyline>\n";
+        << "<title>" << web::HtmlEscape(s.name) << "</title></polyline>\n";
   }
 }
 
@@ -114,7 +116,7 @@ void DrawLegend(const LineChart& chart, const Frame& f, std::ostringstream& out)
     out << "<line x1=\"" << f.right + 10 << "\" x2=\"" << f.right + 30 << "\" y1=\"" << y - 4 << "\" y2=\""
         << y - 4 << "\" stroke=\"" << s.colour << "\" stroke-width=\"2\""
         << (s.dashed ? " stroke-dasharray=\"6 3\"" : "") << "/>"
-        << "<text x=\"" << f.right + 34 << "\" y=\"" << y << "\">" << Escape(s.name) << "</text>\n";
+        << "<text x=\"" << f.right + 34 << "\" y=\"" << y << "\">" << web::HtmlEscape(s.name) << "</text>\n";
     y += 16;
   }
 }
@@ -135,21 +137,6 @@ std::vector<double> NiceTicks(double low, double high, int count) {
     ticks.push_back(std::abs(t) < step * 1e-9 ? 0.0 : t);
   }
   return ticks;
-}
-
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 std::string ShortNumber(double value) {
@@ -200,7 +187,7 @@ std::string Render(const Histogram& h) {
   out << "<svg class=\"chart histogram\" width=\"" << h.width
       << "\" height=\"" << h.height << "\" viewBox=\"0 0 " << h.width << " " << h.height
       << "\" font-size=\"10\" font-family=\"sans-serif\">\n";
-  out << "<text x=\"" << f.left << "\" y=\"14\" font-weight=\"600\">" << Escape(h.title) << "</text>\n";
+  out << "<text x=\"" << f.left << "\" y=\"14\" font-weight=\"600\">" << web::HtmlEscape(h.title) << "</text>\n";
   out << "<line x1=\"" << f.left << "\" x2=\"" << f.right << "\" y1=\"" << f.bottom << "\" y2=\"" << f.bottom
       << "\" stroke=\"#999\"/>\n";
   for (int b = 0; b <= bins; ++b) {
@@ -210,12 +197,12 @@ std::string Render(const Histogram& h) {
     if (first[b] > 0) {
       out << "<rect x=\"" << Fixed(bar_x(b)) << "\" y=\"" << Fixed(f.bottom - h1) << "\" width=\""
           << Fixed(slot * 0.9) << "\" height=\"" << Fixed(h1) << "\" fill=\"" << h.first_colour << "\"><title>"
-          << Escape(h.first_name) << " " << range << ": " << first[b] << "</title></rect>";
+          << web::HtmlEscape(h.first_name) << " " << range << ": " << first[b] << "</title></rect>";
     }
     if (second[b] > 0) {
       out << "<rect x=\"" << Fixed(bar_x(b)) << "\" y=\"" << Fixed(f.bottom - h1 - h2) << "\" width=\""
           << Fixed(slot * 0.9) << "\" height=\"" << Fixed(h2) << "\" fill=\"" << h.second_colour << "\"><title>"
-          << Escape(h.second_name) << " " << range << ": " << second[b] << "</title></rect>";
+          << web::HtmlEscape(h.second_name) << " " << range << ": " << second[b] << "</title></rect>";
     }
   }
   out << "\n<text x=\"" << f.left - 3 << "\" y=\"" << f.top + 8 << "\" text-anchor=\"end\">" << tallest
@@ -224,7 +211,7 @@ std::string Render(const Histogram& h) {
       << "<text x=\"" << f.right << "\" y=\"" << f.bottom + 12 << "\" text-anchor=\"end\">&gt;=" << ShortNumber(h.x_max)
       << "</text>\n";
   out << "<text x=\"" << (f.left + f.right) / 2 << "\" y=\"" << f.bottom + 26 << "\" text-anchor=\"middle\">"
-      << Escape(h.x_label) << "</text>\n";
+      << web::HtmlEscape(h.x_label) << "</text>\n";
   DrawMarkers(h.markers, 0.0, h.x_max, f, [&](double x) { return f.left + slot * bins * x / h.x_max; }, out);
   out << "</svg>\n";
   return out.str();

@@ -52,7 +52,6 @@ std::string Render(const Histogram& histogram);
 
 // Round tick positions covering [low, high] (about `count` of them).
 std::vector<double> NiceTicks(double low, double high, int count);
-std::string Escape(const std::string& text);    // for text content and attributes
 std::string ShortNumber(double value);          // "0.012", "1.5e-05"
 
 }  // namespace c3po::svg

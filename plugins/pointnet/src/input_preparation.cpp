@@ -8,18 +8,8 @@
 namespace c3po::pointnet {
 
 PointSet FinitePoints(const PointSet& cloud) {
-  Eigen::Index finite = 0;
-  for (Eigen::Index j = 0; j < cloud.cols(); ++j) finite += cloud.col(j).allFinite() ? 1 : 0;
-  if (finite == cloud.cols()) {
-    if (finite == 0) throw InputError("point cloud has no finite point (pointnet needs at least one)");
-    return cloud;
-  }
-  if (finite == 0) throw InputError("point cloud has no finite point (pointnet needs at least one)");
-  PointSet kept(3, finite);
-  Eigen::Index k = 0;
-  for (Eigen::Index j = 0; j < cloud.cols(); ++j) {
-    if (cloud.col(j).allFinite()) kept.col(k++) = cloud.col(j);
-  }
+  PointSet kept = FiniteColumns(cloud);
+  if (kept.cols() == 0) throw InputError("point cloud has no finite point (pointnet needs at least one)");
   return kept;
 }
 

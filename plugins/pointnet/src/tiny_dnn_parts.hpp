@@ -3,9 +3,9 @@
 // layers, activations, optimiser interface and the sequential network.
 // Included only by plugins/pointnet sources (never by a public header).
 //
-// Debian's tiny-dnn 1.0.0a3 headers include cereal and stb, which the package
-// does not ship; plugins/pointnet/tiny_dnn_deps provides declaration-only
-// stand-ins, and CNN_NO_SERIALIZATION is defined by the CMake target
+// Debian's tiny-dnn 1.0.0a3 headers include cereal (Debian's libcereal-dev)
+// and stb (declaration-only stand-ins in plugins/pointnet/tiny_dnn_deps), and
+// CNN_NO_SERIALIZATION is defined by the CMake target
 // (tiny-dnn's own serialisation is not used: see model_file.cpp). tiny_dnn.h
 // itself is not included: it pulls in the quantized layers (gemmlowp) and the
 // image/caffe I/O.

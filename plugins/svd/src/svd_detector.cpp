@@ -18,24 +18,6 @@ namespace {
 // Cloud subsample that measures the cloud's extent for box-aligned translations.
 constexpr int kExtentPoints = 2000;
 
-// The finite columns, evenly strided down to at most `limit` of them (0 = no
-// limit): the finite points of rank floor(j m / k), j = 0..k-1, of the m
-// finite ones. Deterministic, one pass over the input plus one to count; with
-// m <= limit every finite column is kept, in order.
-PointSet FiniteStridedColumns(const PointSet& points, int limit) {
-  Eigen::Index finite = 0;
-  for (Eigen::Index i = 0; i < points.cols(); ++i) finite += points.col(i).allFinite() ? 1 : 0;
-  const Eigen::Index kept = limit > 0 ? std::min<Eigen::Index>(finite, limit) : finite;
-  PointSet subset(3, kept);
-  Eigen::Index rank = 0, next = 0;
-  for (Eigen::Index i = 0; i < points.cols() && next < kept; ++i) {
-    if (!points.col(i).allFinite()) continue;
-    if (rank == next * finite / kept) subset.col(next++) = points.col(i);
-    ++rank;
-  }
-  return subset;
-}
-
 // At most `count` distinct columns, chosen by a partial Fisher-Yates shuffle.
 PointSet Subsample(const PointSet& points, int count, std::uint64_t seed) {
   if (points.cols() <= count) return points;

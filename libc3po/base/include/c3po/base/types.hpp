@@ -41,4 +41,22 @@ inline PointSet StridedColumns(const PointSet& points, Eigen::Index limit) {
   return subset;
 }
 
+// The finite columns (no NaN or infinite coordinate), in order.
+inline PointSet FiniteColumns(const PointSet& points) {
+  Eigen::Index finite = 0;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) finite += points.col(i).allFinite() ? 1 : 0;
+  if (finite == points.cols()) return points;
+  PointSet kept(3, finite);
+  for (Eigen::Index i = 0, k = 0; i < points.cols(); ++i) {
+    if (points.col(i).allFinite()) kept.col(k++) = points.col(i);
+  }
+  return kept;
+}
+
+// StridedColumns of the finite columns: the finite points of rank
+// floor(j m / k), j = 0..k-1, of the m finite ones (k = min(m, limit)).
+inline PointSet FiniteStridedColumns(const PointSet& points, Eigen::Index limit) {
+  return StridedColumns(FiniteColumns(points), limit);
+}
+
 }  // namespace c3po

@@ -1,15 +1,13 @@
 #pragma once
-// Dataset directory: manifest.jsonl + one cloud file per line (design.md).
+// Dataset directory: manifest.jsonl + one cloud file per line (reading, and
+// the manifest line schema below; writing is dataset_writer.hpp).
 // Line: {"cloud": "000000.ply"} plus optional ground truth "R" (3x3 rows),
 // "t", "keypoints" (posed, N x 3), "detected_keypoints" (N x 3) and
 // "visible" (N booleans, for rendered depth clouds).
-#include <mutex>
 #include <optional>
-#include <set>
 #include <string>
 #include <vector>
 
-#include "c3po/base/atomic_file.hpp"
 #include "c3po/base/types.hpp"
 
 namespace c3po {
@@ -41,36 +39,5 @@ DatasetEntry ParseManifestLine(const std::string& line, const std::string& where
 // One JSON object, no newline; doubles printed so they read back exactly.
 // Throws std::invalid_argument for non-finite values or mismatched sizes.
 std::string ManifestLine(const DatasetEntry& entry);
-
-// Writes a dataset into a hidden temporary sibling folder; Commit() renames it
-// to `dir` (replacing an existing dataset). Destroying an uncommitted writer
-// removes the temporary folder, so an interrupted run leaves no dataset.
-class DatasetWriter {
- public:
-  explicit DatasetWriter(std::string dir);
-  ~DatasetWriter();
-  DatasetWriter(const DatasetWriter&) = delete;
-  DatasetWriter& operator=(const DatasetWriter&) = delete;
-
-  // Writes the cloud as binary PLY under entry.cloud and records the entry.
-  // Thread-safe: parallel producers may call Add concurrently.
-  // Entries are written to the manifest in the order of their `order` keys
-  // (so parallel producers can add out of order). Thread-safe. Throws
-  // InputError("dir: ...") for an unsafe cloud path or a write failure.
-  void Add(std::size_t order, const DatasetEntry& entry, const PointSet& cloud);
-  // Writes manifest.jsonl and renames the folder to `dir`. An existing dataset
-  // (a folder with manifest.jsonl) or an empty folder is replaced; any other
-  // existing file or folder is refused with InputError (also checked by the
-  // constructor, so a long run fails before it starts).
-  void Commit();
-  const std::string& temporary_dir() const { return folder_.path(); }
-
- private:
-  StagedFolder folder_;
-  std::mutex mutex_;   // guards lines_, clouds_, committed_
-  std::vector<std::pair<std::size_t, std::string>> lines_;
-  std::set<std::string> clouds_;
-  bool committed_ = false;
-};
 
 }  // namespace c3po

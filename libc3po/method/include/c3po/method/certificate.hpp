@@ -1,5 +1,5 @@
 #pragma once
-// Certificates (paper Section V; method.md "Certificates"). Each certificate is
+// Certificates (paper Section V; docs/method.md "Certificates"). Each certificate is
 // a value that carries its evidence, not a bare bool.
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// The keypoint corrector (paper Section VI-B, eq. 17; method.md step 3):
+// The keypoint corrector (paper Section VI-B, eq. 17; docs/method.md step 3):
 //   f(y) = kappa * L_pc(T(y)) + theta * L_kp(y),   y = ỹ + Δy,
 //   L_kp(y) = (1/N) sum_i ||y_i - T(y) b_i||^2   (the registration residual),
 //   L_pc(T) = one-sided Chamfer from the input X to the posed sample T·B̂,

@@ -1,5 +1,5 @@
 #pragma once
-// The C-3PO forward pass for one cloud (method.md "Pipeline"): detected
+// The C-3PO forward pass for one cloud (docs/method.md "Pipeline"): detected
 // keypoints -> registration (eq. 8) -> corrector (eq. 17) -> certificates.
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Certificate-gated self-training (paper Section VI-C, Algorithm 1; method.md
+// Certificate-gated self-training (paper Section VI-C, Algorithm 1; docs/method.md
 // "Self-supervised"): each batch runs detector -> corrector -> certificates
 // and only observably correct samples contribute, regressed onto their
 // corrected keypoints. In the reference the corrector's backward rule

@@ -1,7 +1,7 @@
 #pragma once
 // The `pointnet` keypoint detector: a PointNet regressor (Qi et al. 2017) from a
 // partial point cloud X to the N semantic keypoints of one object (the
-// detector of C-3PO, paper Section VI-A and method.md "Pipeline" step 1).
+// detector of C-3PO, paper Section VI-A and docs/method.md "Pipeline" step 1).
 //
 // Network (tiny-dnn, with a custom Eigen-backed point encoder layer):
 //   input  : n points of X minus its centroid, divided by a fixed scale s

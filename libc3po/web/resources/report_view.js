@@ -1,45 +1,3 @@
-// Static CSS and the 3D-view script of the evaluation report.
-#include "report_page.hpp"
-
-namespace c3po::report_page {
-
-std::string Style() {
-  return R"page(<style>
-  body { margin: 0 auto; max-width: 1100px; padding: 12px 20px 40px; font: 14px/1.45 system-ui, sans-serif; color: #222; }
-  h1 { font-size: 21px; margin: 8px 0 4px; }
-  h2 { font-size: 16px; margin: 26px 0 8px; border-bottom: 1px solid #ddd; padding-bottom: 3px; }
-  .meta, .settings, .note { color: #555; font-size: 12.5px; }
-  code, .mono { font-family: ui-monospace, monospace; font-size: 12px; }
-  table { border-collapse: collapse; font-size: 13px; }
-  th, td { padding: 3px 9px; border-bottom: 1px solid #e4e4e4; text-align: right; white-space: nowrap; }
-  th:first-child, td:first-child { text-align: left; }
-  th { background: #f3f3f3; }
-  tr.subset td:first-child { padding-left: 22px; color: #444; }
-  td.bad { color: #b00; font-weight: 600; }
-  #soundness { padding: 8px 12px; border-radius: 6px; }
-  #soundness.sound { background: #eaf6ea; border: 1px solid #9c9; }
-  #soundness.unsound { background: #fbeaea; border: 1px solid #d99; }
-  #soundness h2 { margin-top: 4px; border: 0; }
-  .charts { display: flex; flex-wrap: wrap; gap: 8px 14px; }
-  svg.chart { background: #fafafa; border: 1px solid #e6e6e6; }
-  #view-buttons button { margin: 0 6px 6px 0; padding: 4px 9px; cursor: pointer; border: 1px solid #aaa;
-                         border-radius: 4px; background: #fff; }
-  #view-buttons button.certified { border-color: #2e8b57; }
-  #view-buttons button.rejected { border-color: #b05050; }
-  #view-buttons button.false-certificate { background: #fbeaea; }
-  #view-buttons button.active { font-weight: 600; box-shadow: 0 0 0 2px #4363d8; }
-  #view3d { position: relative; width: 100%; height: 520px; background: #f4f4f4; border: 1px solid #ddd; }
-  #view3d canvas { display: block; cursor: grab; }
-  #view-info { margin: 6px 0; font-size: 13px; }
-  .legend span { display: inline-block; margin-right: 14px; font-size: 12.5px; }
-  .swatch { display: inline-block; width: 11px; height: 11px; border-radius: 6px; margin-right: 4px;
-            vertical-align: -1px; border: 1px solid #0003; }
-</style>
-)page";
-}
-
-std::string ViewScript() {
-  return R"page(<script type="module">
 const data = JSON.parse(document.getElementById('c3po-views').textContent);
 const report = {views: data.views.length, webgl: false, frames: 0, shown: null, error: null};
 window.c3poReport = report;
@@ -75,7 +33,8 @@ function makeViewer(THREE, box) {
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0xf4f4f4);
   const camera = new THREE.PerspectiveCamera(35, 1, 1e-3, 1e3);
-  scene.add(new THREE.HemisphereLight(0xffffff, 0x808080, 2.0));
+  // three.js r111 (Debian libjs-three): legacy light units, 1/pi of the physical ones.
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x808080, 2.0 / Math.PI));
   const content = new THREE.Group();
   scene.add(content);
   const orbit = {theta: 0.6, phi: 1.1, distance: 1, target: new THREE.Vector3()};
@@ -236,8 +195,3 @@ try {
   document.getElementById('view3d').textContent = '3D view unavailable: ' + error.message;
 }
 document.body.dataset.ready = '1';
-</script>
-)page";
-}
-
-}  // namespace c3po::report_page

@@ -1,65 +1,3 @@
-// Static parts of the annotation page. The page reads its data from the
-// #c3po-data JSON element and three.js from the #c3po-three text element
-// (imported through a Blob URL, so nothing is fetched from the network).
-#include "annotation_page_html.hpp"
-
-namespace c3po::page {
-
-std::string Head(const std::string& title) {
-  return R"page(<!doctype html>
-<html lang="en">
-<head>
-<meta charset="utf-8">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<link rel="icon" href="data:,">
-<title>c3po annotate: )page" +
-         title + R"page(</title>
-<style>
-  html, body { margin: 0; height: 100%; font: 14px/1.4 system-ui, sans-serif; color: #222; }
-  body { display: flex; }
-  #view { position: relative; flex: 1; min-width: 200px; overflow: hidden; background: #f4f4f4; }
-  #view canvas { display: block; cursor: crosshair; }
-  #labels { position: absolute; inset: 0; pointer-events: none; }
-  .label.hidden-behind { opacity: 0.35; }
-  .label { position: absolute; transform: translate(8px, -50%); white-space: nowrap;
-           font-size: 12px; padding: 0 3px; border-radius: 3px; background: rgba(255,255,255,.8); }
-  #panel { width: 340px; overflow-y: auto; padding: 10px 14px; border-left: 1px solid #ccc; background: #fff; }
-  h1 { font-size: 17px; margin: 4px 0 6px; }
-  h2 { font-size: 14px; margin: 14px 0 4px; }
-  .info { color: #555; font-size: 12px; }
-  #keypoint-list { list-style: none; padding: 0; margin: 0; }
-  #keypoint-list li { display: flex; align-items: center; gap: 6px; padding: 2px 0; }
-  #keypoint-list input { width: 90px; }
-  .swatch { display: inline-block; width: 12px; height: 12px; border-radius: 6px; border: 1px solid #0004; }
-  .coords { color: #666; font-size: 11px; font-family: monospace; }
-  #notices { color: #8a4b00; font-size: 12px; padding-left: 16px; }
-  button { cursor: pointer; }
-  #download { margin-top: 12px; padding: 6px 10px; font-weight: 600; }
-</style>
-</head>
-<body>
-<div id="view"><div id="labels"></div></div>
-<div id="panel">
-  <h1 id="title"></h1>
-  <div class="info" id="info"></div>
-  <p class="info">Drag: rotate &middot; right-drag or shift-drag: pan &middot; wheel: zoom.<br>
-  Click the surface to add a keypoint; click a keypoint to remove it (indicator sets that
-  contain it are dropped, the others renumbered).</p>
-  <button id="up-axis" title="which model axis points up on screen">Up axis: Z</button>
-  <h2 id="count"></h2>
-  <ul id="keypoint-list"></ul>
-  <h2>Indicator sets</h2>
-  <div id="legend" class="info"></div>
-  <button id="download">Download object JSON</button>
-  <div class="info">Save it next to the original object file (the mesh path is relative to it);
-  <code>c3po annotate --edit</code> and every other command read it.</div>
-  <ul id="notices"></ul>
-</div>
-)page";
-}
-
-std::string AppScript() {
-  return R"page(<script type="module">
 const data = JSON.parse(document.getElementById('c3po-data').textContent);
 const object = data.object;
 const notices = document.getElementById('notices');
@@ -227,8 +165,9 @@ function makeView(THREE) {
       {color: 0xb4bccb, flatShading: true, side: THREE.DoubleSide, roughness: 0.85, metalness: 0}));
   scene.add(surface);
   const camera = new THREE.PerspectiveCamera(35, 1, diameter * 0.005, diameter * 200);
-  scene.add(new THREE.HemisphereLight(0xffffff, 0x707070, 1.6));
-  const headlight = new THREE.DirectionalLight(0xffffff, 1.6);
+  // three.js r111 (Debian libjs-three): legacy light units, 1/pi of the physical ones.
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x707070, 1.6 / Math.PI));
+  const headlight = new THREE.DirectionalLight(0xffffff, 1.6 / Math.PI);
   headlight.position.set(0.3, 0.5, 1);
   camera.add(headlight);
   scene.add(camera);
@@ -263,7 +202,7 @@ function makeView(THREE) {
     requestRender();
   });
   function pan(dx, dy) {
-    const scale = orbit.distance * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) * 2 / canvas.clientHeight;
+    const scale = orbit.distance * Math.tan(camera.fov / 2 * Math.PI / 180) * 2 / canvas.clientHeight;
     const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
     const up = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
     target.addScaledVector(right, -dx * scale).addScaledVector(up, dy * scale);
@@ -314,7 +253,7 @@ function makeView(THREE) {
   }
   function rebuild() {
     for (const child of keypointGroup.children) child.material.dispose();
-    keypointGroup.clear();
+    while (keypointGroup.children.length) keypointGroup.remove(keypointGroup.children[0]);   // Object3D.clear() is r123+
     labelBox.replaceChildren();
     labels = state.keypoints.map((p, i) => {
       const marker = new THREE.Mesh(sphere, new THREE.MeshStandardMaterial({color: keypointColour(i)}));
@@ -425,8 +364,3 @@ function makeView(THREE) {
   };
   return {rebuild, firstFrame};
 }
-</script>
-)page";
-}
-
-}  // namespace c3po::page

@@ -1,0 +1,39 @@
+#pragma once
+// JSON of c3po's value types, written once for every output schema
+// (certify lines, manifests, object files, evaluation JSON, pages): a point
+// set is a list of [x, y, z] rows, a pose is "R" (three rows) and "t".
+// Json is nlohmann::json or nlohmann::ordered_json (key order of a schema).
+#include <nlohmann/json.hpp>
+
+#include "c3po/base/types.hpp"
+
+namespace c3po {
+
+// [[x, y, z], ...], one row per column of `points`.
+template <class Json = nlohmann::json>
+Json PointsToJson(const PointSet& points) {
+  Json rows = Json::array();
+  for (Eigen::Index i = 0; i < points.cols(); ++i) rows.push_back({points(0, i), points(1, i), points(2, i)});
+  return rows;
+}
+
+// The rotation's rows: [[r00, r01, r02], [r10, ...], [r20, ...]].
+template <class Json = nlohmann::json>
+Json RotationToJson(const Eigen::Matrix3d& R) {
+  return {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
+}
+
+// [x, y, z].
+template <class Json = nlohmann::json>
+Json VectorToJson(const Eigen::Vector3d& v) {
+  return {v(0), v(1), v(2)};
+}
+
+// Sets json["R"] and json["t"] of a pose.
+template <class Json>
+void SetPoseJson(const Pose& pose, Json* json) {
+  (*json)["R"] = RotationToJson<Json>(pose.R);
+  (*json)["t"] = VectorToJson<Json>(pose.t);
+}
+
+}  // namespace c3po
