@@ -19,6 +19,7 @@
 #include "c3po/plugins/registry.hpp"
 #include "command.hpp"
 #include "common.hpp"
+#include "robust_options.hpp"
 
 namespace c3po::cli {
 namespace {
@@ -37,6 +38,7 @@ struct CertifyCommand {
   bool no_correct = false;
   std::string solver = "fast";
   std::string loss = "mean";
+  RobustCliOptions robust;
 };
 
 // One cloud to process: from the command line or from a dataset manifest.
@@ -85,6 +87,9 @@ nlohmann::json PointsJson(const PointSet& points) {
   return list;
 }
 
+// Outlier indices in the JSON line are capped (the count is always exact).
+constexpr std::size_t kMaxListedOutliers = 100;
+
 nlohmann::ordered_json EstimateJson(const std::string& cloud, const PoseEstimate& e) {
   const Pose& T = e.scene_from_model;
   nlohmann::ordered_json line;  // keys in the documented order, "cloud" first
@@ -106,6 +111,25 @@ nlohmann::ordered_json EstimateJson(const std::string& cloud, const PoseEstimate
   line["cost_before"] = std::isfinite(e.correction.cost_before) ? nlohmann::ordered_json(e.correction.cost_before) : nlohmann::ordered_json(nullptr);
   line["cost_after"] = std::isfinite(e.correction.cost_after) ? nlohmann::ordered_json(e.correction.cost_after) : nlohmann::ordered_json(nullptr);
   line["status"] = ToString(e.correction.registration);
+  // Outlier-robust evidence (issue 16).
+  const ObservableCorrectness& oc = e.certificate.oc;
+  const NonDegeneracy& nd = e.certificate.nd;
+  auto finite = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); };
+  line["max_outliers"] = oc.max_outliers;
+  line["outliers"] = oc.outlier_count;
+  const std::size_t listed = std::min(oc.outlier_indices.size(), kMaxListedOutliers);
+  line["outlier_indices"] = std::vector<int>(oc.outlier_indices.begin(), oc.outlier_indices.begin() + listed);
+  line["outlier_indices_truncated"] = listed < oc.outlier_indices.size();
+  line["distance_quantiles"] = {finite(oc.quantile50), finite(oc.quantile90), finite(oc.quantile99), finite(oc.max_point_distance)};
+  line["max_inlier_distance"] = oc.max_inlier_distance;
+  line["keypoint_support"] = nd.keypoint_support;
+  line["nd_set_support"] = nd.set_min_support;
+  line["nd_sets"] = nd.sets_passed;
+  line["nd_local"] = nd.local_checked ? nlohmann::ordered_json(nd.local.passed) : nlohmann::ordered_json(nullptr);
+  line["nd_local_eigenvalue"] = nd.local.min_eigenvalue;
+  line["nd_local_motion"] = {nd.local.motion(0), nd.local.motion(1), nd.local.motion(2),
+                             nd.local.motion(3), nd.local.motion(4), nd.local.motion(5)};
+  line["nd_local_rank"] = nd.local.model_rank;
   line["ms"] = e.milliseconds;
   return line;
 }
@@ -121,10 +145,10 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
   }
   const Eigen::AngleAxisd rotation(e.scene_from_model.R);
   std::snprintf(text, sizeof text,
-                "%s  %s  oc=%d (%.4g)  nd=%d (set %d)  t=[%.4f %.4f %.4f]  angle=%.1f deg  %d it  %.1f ms",
+                "%s  %s  oc=%d (%.4g; %d/%d outliers)  nd=%d (set %d, local %.3g)  t=[%.4f %.4f %.4f]  angle=%.1f deg  %d it  %.1f ms",
                 cloud.c_str(), e.certified() ? "CERTIFIED" : "not certified", e.certificate.oc.passed,
-                e.certificate.oc.max_point_distance, e.certificate.nd.passed,
-                e.certificate.nd.passing_set, e.scene_from_model.t(0), e.scene_from_model.t(1),
+                e.certificate.oc.max_point_distance, e.certificate.oc.outlier_count, e.certificate.oc.max_outliers,
+                e.certificate.nd.passed, e.certificate.nd.passing_set, e.certificate.nd.local.min_eigenvalue, e.scene_from_model.t(0), e.scene_from_model.t(1),
                 e.scene_from_model.t(2), rotation.angle() * 180.0 / M_PI, e.correction.iterations,
                 e.milliseconds);
   return text;
@@ -132,19 +156,26 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
 
 // --eps-oc auto: estimate eps_oc from the clouds being certified and the oc
 // distances just computed (they do not depend on eps_oc), then decide oc again.
+// With a budget m the distance used is each cloud's (m+1)-th largest point
+// distance (robust: the m farthest points never set eps_oc), and both
+// certificates are decided again (nd_m depends on the accepted points).
 double DecideAutoEpsOc(const ObjectModel& object, const std::vector<PointSet>& clouds,
-                       bool check_keypoint_agreement, std::vector<CloudOutcome>* outcomes) {
+                       const CertificateOptions& certificate, std::vector<CloudOutcome>* outcomes) {
   std::vector<PointSet> usable;
   std::vector<double> oc_distances;
   for (std::size_t i = 0; i < outcomes->size(); ++i) {
     const CloudOutcome& outcome = (*outcomes)[i];
     if (!outcome.error.empty()) continue;
     usable.push_back(clouds[i]);
-    if (outcome.estimate.ok()) oc_distances.push_back(outcome.estimate.certificate.oc.max_point_distance);
+    if (outcome.estimate.ok()) oc_distances.push_back(outcome.estimate.certificate.oc.budget_distance);
   }
   const AutoEpsOcResult chosen = EstimateEpsOc(object, usable, AutoEpsOcOptions{}, &oc_distances);
-  for (CloudOutcome& outcome : *outcomes) {
-    if (outcome.error.empty()) RethresholdObservableCorrectness(&outcome.estimate.certificate.oc, chosen.eps_oc, check_keypoint_agreement);
+  CertificateOptions decided = certificate;
+  decided.eps_oc = chosen.eps_oc;
+  for (std::size_t i = 0; i < outcomes->size(); ++i) {
+    PoseEstimate& estimate = (*outcomes)[i].estimate;
+    if (!(*outcomes)[i].error.empty() || !estimate.ok()) continue;
+    estimate.certificate = Certify(object, clouds[i], estimate.scene_from_model, estimate.keypoints, decided);
   }
   std::fprintf(stderr, "c3po certify: --eps-oc auto = %.6g (%s; eps_w = %.4g, eps_s = %.4g); evidence %s\n",
                chosen.eps_oc, chosen.rule.c_str(), chosen.noise.eps_w, chosen.sampling.eps_s, chosen.ToJson().c_str());
@@ -161,9 +192,15 @@ int Run(const CertifyCommand& cmd) {
   options.corrector.solver = ParseCorrectorSolver(cmd.solver);
   options.corrector.loss = ParsePointCloudLoss(cmd.loss);
   options.certificate = CertificateOptions::FromObject(object.spec());
+  ApplyRobustOptions(cmd.robust, &options);
   const bool auto_eps_oc = cmd.eps_oc_text == "auto";
   if (!cmd.eps_oc_text.empty() && !auto_eps_oc) options.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
   if (!cmd.delta_nd_text.empty()) options.certificate.delta_nd = ParseThreshold(cmd.delta_nd_text, object.diameter(), "--delta-nd");
+  try {
+    options.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("c3po certify", e.what());
+  }
   const std::vector<CloudJob> jobs = CollectJobs(cmd);
   const std::unique_ptr<Detector> detector = MakeDetector(cmd, object);
 
@@ -190,7 +227,7 @@ int Run(const CertifyCommand& cmd) {
   });
   progress.Finish();
 
-  if (auto_eps_oc) options.certificate.eps_oc = DecideAutoEpsOc(object, clouds, options.certificate.check_keypoint_agreement, &outcomes);
+  if (auto_eps_oc) options.certificate.eps_oc = DecideAutoEpsOc(object, clouds, options.certificate, &outcomes);
 
   std::ostringstream json_lines;
   int certified = 0, oc = 0, nd = 0, errors = 0;
@@ -214,9 +251,9 @@ int Run(const CertifyCommand& cmd) {
     std::cout << json_lines.str();
   }
   if (!cmd.json) {
-    std::printf("certified %d/%zu (oc %d, nd %d, errors %d); eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g)\n",
+    std::printf("certified %d/%zu (oc %d, nd %d, errors %d); eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g); %s\n",
                 certified, jobs.size(), oc, nd, errors, options.certificate.eps_oc,
-                options.certificate.delta_nd, object.diameter());
+                options.certificate.delta_nd, object.diameter(), DescribeRobustOptions(options).c_str());
   }
   if (errors > 0) return 2;
   return certified == static_cast<int>(jobs.size()) ? 0 : 1;
@@ -240,6 +277,7 @@ RunFunction SetupCertify(CLI::App& command) {
   command.add_flag("--no-correct", cmd->no_correct, "Certify the plain registration of the detected keypoints");
   command.add_option("--solver", cmd->solver, "Corrector solver: fast (default) or gd (the reference's)");
   command.add_option("--loss", cmd->loss, "Point-cloud loss: mean (paper, default) or max (reference code)");
+  AddRobustOptions(command, &cmd->robust);
   return [cmd]() { return Run(*cmd); };
 }
 

@@ -17,6 +17,7 @@
 #include "c3po/web/report.hpp"
 #include "command.hpp"
 #include "common.hpp"
+#include "robust_options.hpp"
 
 namespace c3po::cli {
 namespace {
@@ -37,6 +38,7 @@ struct EvalCommand {
   std::string delta_nd_text;
   std::string solver = "fast";
   std::string loss = "mean";
+  RobustCliOptions robust;
   bool no_icp = false;
   int icp_iterations = 30;
   std::string icp_max_distance;
@@ -123,6 +125,7 @@ EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object)
   }
   options.pipeline.corrector.solver = ParseCorrectorSolver(cmd.solver);
   options.pipeline.corrector.loss = ParsePointCloudLoss(cmd.loss);
+  ApplyRobustOptions(cmd.robust, &options.pipeline);
   options.run_icp = !cmd.no_icp;
   options.icp.max_iterations = cmd.icp_iterations;
   options.icp.trim_fraction = cmd.icp_trim;
@@ -181,6 +184,9 @@ std::string CommandLine(const EvalCommand& cmd) {
   line += " --adds " + cmd.adds_variant + " --adds-threshold " + cmd.adds_threshold + " --auc-max " + cmd.auc_max;
   if (!cmd.eps_oc_text.empty()) line += " --eps-oc " + cmd.eps_oc_text;
   if (!cmd.delta_nd_text.empty()) line += " --delta-nd " + cmd.delta_nd_text;
+  if (!cmd.robust.max_outliers.empty()) line += " --max-outliers " + cmd.robust.max_outliers;
+  if (cmd.robust.robust_loss != "none") line += " --robust-loss " + cmd.robust.robust_loss;
+  if (!cmd.robust.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + cmd.robust.nd_min_eigenvalue;
   if (cmd.no_icp) line += " --no-icp";
   return line;
 }
@@ -246,6 +252,7 @@ RunFunction SetupEval(CLI::App& command) {
   command.add_option("--delta-nd", cmd->delta_nd_text, "Non-degeneracy threshold (default: the object's)");
   command.add_option("--solver", cmd->solver, "Corrector solver: fast (default) or gd");
   command.add_option("--loss", cmd->loss, "Point-cloud loss: mean (default) or max");
+  AddRobustOptions(command, &cmd->robust);
   command.add_flag("--no-icp", cmd->no_icp, "Skip the KeyPo + ICP rows");
   command.add_option("--icp-iterations", cmd->icp_iterations, "ICP iterations (default 30)");
   command.add_option("--icp-max-distance", cmd->icp_max_distance, "ICP correspondence gate (default: none)");

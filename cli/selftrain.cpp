@@ -14,6 +14,7 @@
 #include "c3po/method/selftrain.hpp"
 #include "command.hpp"
 #include "common.hpp"
+#include "robust_options.hpp"
 #include "training_common.hpp"
 
 namespace c3po::cli {
@@ -30,6 +31,7 @@ struct SelftrainCommand {
   std::string eps_oc_text;
   std::string delta_nd_text;
   std::string solver = "fast";
+  RobustCliOptions robust;
   bool resume = false;
 };
 
@@ -60,6 +62,7 @@ int Run(SelftrainCommand cmd) {
   const bool auto_eps_oc = cmd.eps_oc_text == "auto";
   if (!cmd.eps_oc_text.empty() && !auto_eps_oc) options.pipeline.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
   if (!cmd.delta_nd_text.empty()) options.pipeline.certificate.delta_nd = ParseThreshold(cmd.delta_nd_text, object.diameter(), "--delta-nd");
+  ApplyRobustOptions(cmd.robust, &options.pipeline);
   options.checkpoint_path = cmd.output_path + ".ckpt";
   try {
     options.Check();
@@ -80,7 +83,7 @@ int Run(SelftrainCommand cmd) {
     const CertifiedFraction initial = MeasureCertified(object, clouds, *detector, options.pipeline);
     std::vector<double> oc_distances;
     for (const auto& estimate : initial.estimates) {
-      if (estimate.ok()) oc_distances.push_back(estimate.certificate.oc.max_point_distance);
+      if (estimate.ok()) oc_distances.push_back(estimate.certificate.oc.budget_distance);
     }
     const AutoEpsOcResult chosen = EstimateEpsOc(object, clouds, AutoEpsOcOptions{}, &oc_distances);
     options.pipeline.certificate.eps_oc = chosen.eps_oc;
@@ -92,9 +95,10 @@ int Run(SelftrainCommand cmd) {
   EpochLogFile log(cmd.output_path);
   if (cmd.resume) log.LoadExisting();
   std::fprintf(stderr, "self-training on %zu unlabelled clouds of %s: eps_oc = %.6g, delta_nd = %.6g (d = %.6g), "
-               "%d epochs, batch %d, %s lr %g\n",
+               "%s, %d epochs, batch %d, %s lr %g\n",
                clouds.size(), object.name().c_str(), options.pipeline.certificate.eps_oc,
-               options.pipeline.certificate.delta_nd, object.diameter(), options.epochs, options.batch,
+               options.pipeline.certificate.delta_nd, object.diameter(),
+               DescribeRobustOptions(options.pipeline).c_str(), options.epochs, options.batch,
                cmd.optimizer.c_str(), cmd.lr);
   ProgressBar progress("selftrain", 1);
   const SelfTrainResult result = SelfTrain(
@@ -147,6 +151,7 @@ RunFunction SetupSelftrain(CLI::App& command) {
                      "Observable-correctness threshold: distance, fraction of d (3%d) or auto (estimated from the clouds)");
   command.add_option("--delta-nd", cmd->delta_nd_text, "Non-degeneracy threshold");
   command.add_option("--solver", cmd->solver, "Corrector solver: fast or gd");
+  AddRobustOptions(command, &cmd->robust);
   command.add_option("--seed", o.seed, "Seed (split, shuffling)");
   command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt");
   return [cmd]() { return Run(*cmd); };

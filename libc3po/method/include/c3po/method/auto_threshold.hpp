@@ -87,7 +87,9 @@ AutoEpsOcResult EstimateEpsOc(const ObjectModel& object, const std::vector<Point
 
 // The oc decision from its evidence with another threshold (the distances do
 // not depend on eps_oc): lets `certify --eps-oc auto` decide after seeing every
-// cloud's oc distance.
+// cloud's oc distance. Recomputes the outlier evidence under the same budget
+// (oc->max_outliers); defined in certificate.cpp. The nd_m evidence depends on
+// the accepted points, so callers re-run CheckNonDegeneracy when m > 0.
 void RethresholdObservableCorrectness(ObservableCorrectness* oc, double eps_oc,
                                       bool check_keypoint_agreement = true);
 
