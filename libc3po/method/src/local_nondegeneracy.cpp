@@ -61,14 +61,23 @@ LocalNonDegeneracy CheckLocalNonDegeneracy(const ObjectModel& object, const Eige
   options.Check();
   LocalNonDegeneracy result;
   const TwistFrame frame = FrameOf(object);
-  std::vector<Vector6> rows;
-  for (Eigen::Index j = 0; j < nearest_model_point.size(); ++j) {
-    if (j >= static_cast<Eigen::Index>(accepted.size()) || !accepted[j]) continue;
-    const int p = nearest_model_point(j);
-    if (p < 0 || p >= object.sample().cols() || object.sample_on_crease()[p]) continue;
-    rows.push_back(Row(frame, object.sample().col(p), object.sample_normals().col(p)));
-  }
-  result.observed_points = static_cast<int>(rows.size());
+  // The rows J are recomputed on each pass instead of stored: clouds may
+  // hold millions of points.
+  auto for_each_row = [&](const auto& visit) {
+    for (Eigen::Index j = 0; j < nearest_model_point.size(); ++j) {
+      if (j >= static_cast<Eigen::Index>(accepted.size()) || !accepted[j]) continue;
+      const int p = nearest_model_point(j);
+      if (p < 0 || p >= object.sample().cols() || object.sample_on_crease()[p]) continue;
+      visit(Row(frame, object.sample().col(p), object.sample_normals().col(p)));
+    }
+  };
+  Matrix6 H_data = Matrix6::Zero();
+  int rows = 0;
+  for_each_row([&](const Vector6& J) {
+    H_data.noalias() += J * J.transpose();
+    ++rows;
+  });
+  result.observed_points = rows;
   const Matrix6 H_model = ModelInformationMatrix(object);
   // Whitening of H_model on the motions it sees: W = Q_k Λ_k^{-1/2}.
   const Eigen::SelfAdjointEigenSolver<Matrix6> model(H_model);
@@ -78,14 +87,12 @@ LocalNonDegeneracy CheckLocalNonDegeneracy(const ObjectModel& object, const Eige
     if (largest > 0 && model.eigenvalues()(k) > options.model_floor * largest) seen.push_back(k);
   }
   result.model_rank = static_cast<int>(seen.size());
-  if (rows.empty() || seen.empty()) return result;
+  if (rows == 0 || seen.empty()) return result;
   Eigen::MatrixXd W(6, seen.size());
   for (std::size_t i = 0; i < seen.size(); ++i) {
     W.col(i) = model.eigenvectors().col(seen[i]) / std::sqrt(model.eigenvalues()(seen[i]));
   }
-  Matrix6 H_data = Matrix6::Zero();
-  for (const Vector6& J : rows) H_data.noalias() += J * J.transpose();
-  H_data /= static_cast<double>(rows.size());
+  H_data /= static_cast<double>(rows);
   // Generalised eigenproblem H_data ξ = λ H_model ξ on the seen motions.
   const Eigen::MatrixXd A = W.transpose() * H_data * W;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> generalised(0.5 * (A + A.transpose()));
@@ -97,15 +104,15 @@ LocalNonDegeneracy CheckLocalNonDegeneracy(const ObjectModel& object, const Eige
     // m accepted points might be outliers placed to supply exactly the
     // missing information: drop the m that contribute most along ξ_min.
     std::vector<double> contribution;
-    contribution.reserve(rows.size());
-    for (const Vector6& J : rows) contribution.push_back(std::pow(J.dot(motion), 2));
+    contribution.reserve(rows);
+    for_each_row([&](const Vector6& J) { contribution.push_back(std::pow(J.dot(motion), 2)); });
     const std::size_t drop = std::min<std::size_t>(max_outliers, contribution.size());
-    std::partial_sort(contribution.begin(), contribution.begin() + drop, contribution.end(), std::greater<double>());
+    std::nth_element(contribution.begin(), contribution.begin() + drop, contribution.end(), std::greater<double>());
     double kept = 0.0;
     for (std::size_t i = drop; i < contribution.size(); ++i) kept += contribution[i];
     const double model_information = motion.dot(H_model * motion);
     if (model_information > 0) {
-      result.min_eigenvalue = std::min(result.min_eigenvalue, kept / static_cast<double>(rows.size()) / model_information);
+      result.min_eigenvalue = std::min(result.min_eigenvalue, kept / static_cast<double>(rows) / model_information);
     }
   }
   result.passed = result.observed_points >= options.min_points && result.min_eigenvalue >= options.min_eigenvalue;
