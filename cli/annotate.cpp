@@ -10,10 +10,10 @@
 
 #include "c3po/authoring/annotate.hpp"
 #include "c3po/base/error.hpp"
-#include "c3po/io/mesh_io.hpp"
-#include "c3po/web/annotation_page.hpp"
 #include "c3po/geometry/mesh.hpp"
+#include "c3po/io/mesh_io.hpp"
 #include "c3po/object/object_io.hpp"
+#include "c3po/web/annotation_page.hpp"
 #include "command.hpp"
 
 namespace c3po::cli {

@@ -7,13 +7,13 @@
 
 #include "bench_registry.hpp"
 #include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/eval/corrector_benchmark.hpp"
 #include "c3po/io/dataset.hpp"
-#include "c3po/base/error.hpp"
 #include "c3po/object/object_io.hpp"
 #include "command.hpp"
-#include "common.hpp"
-#include "robust_options.hpp"
+#include "options.hpp"
+#include "progress_bar.hpp"
 
 namespace c3po::cli {
 namespace {
@@ -24,8 +24,8 @@ struct CorrectorBenchCommand {
   std::string sigmas = "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1.0";
   double fraction = 0.8;
   std::string solvers = "fast";
-  std::string loss = "mean";
-  std::string eps_oc_text;
+  CorrectorFlags corrector;    // --loss (the solvers are --solvers)
+  ThresholdFlags thresholds;
   std::uint64_t seed = 0;
   int threads = 1;
   int max_clouds = 0;
@@ -33,7 +33,7 @@ struct CorrectorBenchCommand {
   std::string cases_path;
   std::string stray = "0";
   std::string correct = "0.02";
-  RobustCliOptions robust;
+  RobustFlags robust;
 };
 
 nlohmann::json PointsJson(const PointSet& points) {
@@ -93,15 +93,9 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
   options.solvers.clear();
   std::stringstream solver_list(cmd.solvers);
   for (std::string name; std::getline(solver_list, name, ',');) options.solvers.push_back(ParseCorrectorSolver(name));
-  options.corrector.loss = ParsePointCloudLoss(cmd.loss);
-  options.certificate = CertificateOptions::FromObject(object.spec());
-  if (!cmd.eps_oc_text.empty()) options.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
-  PipelineOptions robust;   // the robust options' home is the pipeline
-  robust.corrector = options.corrector;
-  robust.certificate = options.certificate;
-  ApplyRobustOptions(cmd.robust, &robust);
-  options.corrector = robust.corrector;
-  options.certificate = robust.certificate;
+  options.corrector.loss = ParsePointCloudLoss(cmd.corrector.loss);
+  options.certificate = ResolveThresholds(cmd.thresholds, object);
+  ResolveRobust(cmd.robust, &options.certificate, &options.corrector);
   {
     const OutlierBudget stray = ParseOutlierBudget(cmd.stray);   // the same "P%" syntax
     if (stray.count > 0) throw InputError("--stray", "give a percentage of each cloud's points (5%)");
@@ -126,7 +120,7 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
               "d = %.4g, eps_oc = %.4g, loss = %s, %s, %d thread(s)\n",
               object.name().c_str(), rows.empty() ? 0 : rows[0].clouds, 100 * options.fraction,
               object.diameter(), options.certificate.eps_oc, ToString(options.corrector.loss),
-              DescribeRobustOptions(robust).c_str(), options.threads);
+              DescribeRobust(options.certificate, options.corrector).c_str(), options.threads);
   std::printf("times per cloud, medians in ms: corr = correction alone (registration: T(y~) only), "
               "corr cpu = its thread CPU time, cert = certificates, total = corr + cert\n");
   std::printf("certificates: %.1f%% stray points per cloud; correct = Hausdorff(T*·B̂, T̂·B̂) <= %.4g; "
@@ -175,15 +169,15 @@ void SetupCorrectorBench(CLI::App& parent, std::function<int()>* run) {
   sub->add_option("--sigma", cmd->sigmas, "Comma-separated noise levels sigma (fraction of d)");
   sub->add_option("--fraction", cmd->fraction, "Probability that a keypoint is perturbed");
   sub->add_option("--solvers", cmd->solvers, "Corrector solvers to compare: fast,gd");
-  sub->add_option("--loss", cmd->loss, "Point-cloud loss: mean or max");
-  sub->add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold (default: object's)");
-  sub->add_option("--seed", cmd->seed, "Seed of the perturbations");
+  AddLossOption(*sub, &cmd->corrector.loss);
+  AddThresholdOptions(*sub, &cmd->thresholds, AutoEpsOc::kRefused);
+  AddSeedOption(*sub, &cmd->seed, "of the perturbations");
   AddRobustOptions(*sub, &cmd->robust);
   sub->add_option("--stray", cmd->stray, "Add stray points to every cloud: a percentage of its points (5%; "
                                          "half background, half flying pixels; seeded by --seed)");
   sub->add_option("--correct", cmd->correct, "A pose is correct when Hausdorff(T*·B̂, T̂·B̂) is at most this "
                                              "(distance or fraction of d; default 0.02)");
-  sub->add_option("--threads", cmd->threads, "Worker threads (1 gives honest per-cloud times)");
+  AddThreadsOption(*sub, &cmd->threads, "1 gives honest per-cloud times");
   sub->add_option("--max-clouds", cmd->max_clouds, "Use at most this many clouds (0 = all)");
   sub->add_option("--json", cmd->json_path, "Also write the rows as JSON to this file");
   sub->add_option("--cases", cmd->cases_path,

@@ -3,21 +3,19 @@
 // a self-contained HTML report.
 #include <atomic>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
-#include <nlohmann/json.hpp>
 
 #include "c3po/base/atomic_file.hpp"
-#include "c3po/io/dataset.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/eval/evaluation.hpp"
+#include "c3po/io/dataset.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/registry.hpp"
 #include "c3po/web/report.hpp"
 #include "command.hpp"
-#include "common.hpp"
-#include "robust_options.hpp"
+#include "options.hpp"
+#include "progress_bar.hpp"
 
 namespace c3po::cli {
 namespace {
@@ -27,18 +25,14 @@ namespace fs = std::filesystem;
 struct EvalCommand {
   std::string object_path;
   std::string data_dir;
-  std::vector<std::string> models;
+  DetectorFlags detector;                 // --model (repeatable), --detector, --plugin
   std::vector<std::string> selftrained;
-  std::vector<std::string> detectors;
-  std::vector<std::string> plugins;
   std::string adds_threshold = "5%d";
   std::string auc_max = "10%d";
   std::string adds_variant = "symmetric";
-  std::string eps_oc_text;
-  std::string delta_nd_text;
-  std::string solver = "fast";
-  std::string loss = "mean";
-  RobustCliOptions robust;
+  ThresholdFlags thresholds;
+  CorrectorFlags corrector;
+  RobustFlags robust;
   bool no_icp = false;
   int icp_iterations = 30;
   std::string icp_max_distance;
@@ -58,23 +52,6 @@ struct LoadedDetector {
   std::string model_path;               // empty for named detectors
 };
 
-// The JSON header line of a model file (empty object when it has none).
-nlohmann::json ModelHeader(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open model file");
-  std::string line;
-  std::getline(in, line);
-  nlohmann::json header = nlohmann::json::parse(line, nullptr, false);
-  return header.is_object() ? header : nlohmann::json::object();
-}
-
-bool FlaggedSelfTrained(const nlohmann::json& header) {
-  for (const char* key : {"selftrained", "self_trained"}) {
-    if (header.contains(key) && header[key].is_boolean() && header[key].get<bool>()) return true;
-  }
-  return false;
-}
-
 std::string UniqueLabel(std::string label, const std::vector<LoadedDetector>& existing) {
   const std::string base = label;
   for (int k = 2;; ++k) {
@@ -86,21 +63,21 @@ std::string UniqueLabel(std::string label, const std::vector<LoadedDetector>& ex
 }
 
 std::vector<LoadedDetector> LoadDetectors(const EvalCommand& cmd, const ObjectModel& object) {
-  for (const auto& plugin : cmd.plugins) LoadPlugin(plugin);
+  LoadPlugins(cmd.detector);
   std::vector<LoadedDetector> detectors;
   auto add_model = [&](const std::string& path, bool self_trained) {
     LoadedDetector d;
     d.detector = LoadDetectorModel(path, object);
-    d.self_trained = self_trained || FlaggedSelfTrained(ModelHeader(path));
+    d.self_trained = self_trained || ReadModelHeader(path).self_trained;
     d.label = UniqueLabel(fs::path(path).stem().string(), detectors);
     d.model_path = path;
     detectors.push_back(std::move(d));
   };
-  for (const auto& path : cmd.models) add_model(path, false);
+  for (const auto& path : cmd.detector.models) add_model(path, false);
   for (const auto& path : cmd.selftrained) add_model(path, true);
-  for (const auto& name : cmd.detectors) {
+  for (const auto& name : cmd.detector.detectors) {
     LoadedDetector d;
-    if (name != "manifest") d.detector = CreateDetector(name, object);
+    d.detector = MakeDetector("", name, object);
     d.label = UniqueLabel(name, detectors);
     detectors.push_back(std::move(d));
   }
@@ -116,16 +93,12 @@ EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object)
   options.adds_threshold = ParseThreshold(cmd.adds_threshold, d, "--adds-threshold");
   options.auc_max = ParseThreshold(cmd.auc_max, d, "--auc-max");
   options.adds_variant = ParseAddSVariant(cmd.adds_variant);
-  if (!cmd.eps_oc_text.empty()) options.pipeline.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, d, "--eps-oc");
-  if (!cmd.delta_nd_text.empty()) {
-    options.pipeline.certificate.delta_nd = ParseThreshold(cmd.delta_nd_text, d, "--delta-nd");
-  }
+  options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
   if (!(options.pipeline.certificate.eps_oc > 0) || !(options.pipeline.certificate.delta_nd > 0)) {
     throw InputError(cmd.object_path, "the object has no eps_oc / delta_nd: give --eps-oc and --delta-nd");
   }
-  options.pipeline.corrector.solver = ParseCorrectorSolver(cmd.solver);
-  options.pipeline.corrector.loss = ParsePointCloudLoss(cmd.loss);
-  ApplyRobustOptions(cmd.robust, &options.pipeline);
+  ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
+  ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
   options.run_icp = !cmd.no_icp;
   options.icp.max_iterations = cmd.icp_iterations;
   options.icp.trim_fraction = cmd.icp_trim;
@@ -178,15 +151,13 @@ std::vector<TrainingLog> ReadTrainingLogs(const EvalCommand& cmd, const std::vec
 
 std::string CommandLine(const EvalCommand& cmd) {
   std::string line = "c3po eval " + cmd.object_path + " --data " + cmd.data_dir;
-  for (const auto& m : cmd.models) line += " --model " + m;
+  for (const auto& m : cmd.detector.models) line += " --model " + m;
   for (const auto& m : cmd.selftrained) line += " --selftrained " + m;
-  for (const auto& d : cmd.detectors) line += " --detector " + d;
+  for (const auto& d : cmd.detector.detectors) line += " --detector " + d;
   line += " --adds " + cmd.adds_variant + " --adds-threshold " + cmd.adds_threshold + " --auc-max " + cmd.auc_max;
-  if (!cmd.eps_oc_text.empty()) line += " --eps-oc " + cmd.eps_oc_text;
-  if (!cmd.delta_nd_text.empty()) line += " --delta-nd " + cmd.delta_nd_text;
-  if (!cmd.robust.max_outliers.empty()) line += " --max-outliers " + cmd.robust.max_outliers;
-  if (cmd.robust.robust_loss != "none") line += " --robust-loss " + cmd.robust.robust_loss;
-  if (!cmd.robust.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + cmd.robust.nd_min_eigenvalue;
+  if (!cmd.thresholds.eps_oc.empty()) line += " --eps-oc " + cmd.thresholds.eps_oc;
+  if (!cmd.thresholds.delta_nd.empty()) line += " --delta-nd " + cmd.thresholds.delta_nd;
+  line += RobustCommandLine(cmd.robust);
   if (cmd.no_icp) line += " --no-icp";
   return line;
 }
@@ -239,19 +210,14 @@ RunFunction SetupEval(CLI::App& command) {
   auto cmd = std::make_shared<EvalCommand>();
   command.add_option("object", cmd->object_path, "Object JSON")->required();
   command.add_option("--data", cmd->data_dir, "Dataset folder with ground truth (manifest.jsonl + clouds)")->required();
-  command.add_option("--model", cmd->models, "Trained detector model file (row label = file stem); repeatable")->allow_extra_args(false);
+  AddDetectorOptions(command, &cmd->detector, DetectorCount::kMany);
   command.add_option("--selftrained", cmd->selftrained,
                      "Self-trained model file: C-3PO rows (also when a model header says \"selftrained\": true); repeatable")->allow_extra_args(false);
-  command.add_option("--detector", cmd->detectors,
-                     "Detector without a model file (svd; manifest = the manifest's detected_keypoints)->allow_extra_args(false); repeatable");
-  command.add_option("--plugin", cmd->plugins, "Load a detector plugin (shared library)->allow_extra_args(false); repeatable");
   command.add_option("--adds", cmd->adds_variant, "ADD-S variant: symmetric (default; the paper's final tables) or one-sided");
   command.add_option("--adds-threshold", cmd->adds_threshold, "ADD-S score threshold: distance or fraction of d (default 5%d)");
   command.add_option("--auc-max", cmd->auc_max, "Upper end of the ADD-S AUC curve (default 10%d)");
-  command.add_option("--eps-oc", cmd->eps_oc_text, "Observable-correctness threshold (default: the object's)");
-  command.add_option("--delta-nd", cmd->delta_nd_text, "Non-degeneracy threshold (default: the object's)");
-  command.add_option("--solver", cmd->solver, "Corrector solver: fast (default) or gd");
-  command.add_option("--loss", cmd->loss, "Point-cloud loss: mean (default) or max");
+  AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kRefused);
+  AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);
   command.add_flag("--no-icp", cmd->no_icp, "Skip the KeyPo + ICP rows");
   command.add_option("--icp-iterations", cmd->icp_iterations, "ICP iterations (default 30)");

@@ -5,13 +5,13 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "c3po/base/atomic_file.hpp"
-#include "c3po/io/dataset.hpp"
-#include "c3po/base/error.hpp"
 #include "c3po/authoring/indicators.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/io/dataset.hpp"
 #include "c3po/object/object_io.hpp"
 #include "command.hpp"
-#include "common.hpp"
+#include "progress_bar.hpp"
 
 namespace c3po::cli {
 namespace {

@@ -10,7 +10,7 @@
 #include "c3po/base/error.hpp"
 #include "c3po/plugins/registry.hpp"
 #include "command.hpp"
-#include "common.hpp"
+#include "signal_handlers.hpp"
 
 namespace {
 

@@ -6,15 +6,15 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "c3po/method/auto_threshold.hpp"
-#include "c3po/io/dataset.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/method/auto_threshold.hpp"
+#include "c3po/method/selftrain.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/pointnet.hpp"
-#include "c3po/method/selftrain.hpp"
 #include "command.hpp"
-#include "common.hpp"
-#include "robust_options.hpp"
+#include "options.hpp"
+#include "progress_bar.hpp"
 #include "training_common.hpp"
 
 namespace c3po::cli {
@@ -28,10 +28,9 @@ struct SelftrainCommand {
   SelfTrainOptions options;
   double lr = 1e-3;
   std::string optimizer = "adam";
-  std::string eps_oc_text;
-  std::string delta_nd_text;
-  std::string solver = "fast";
-  RobustCliOptions robust;
+  ThresholdFlags thresholds;
+  CorrectorFlags corrector;
+  RobustFlags robust;
   bool resume = false;
 };
 
@@ -57,12 +56,9 @@ int Run(SelftrainCommand cmd) {
     throw InputError("c3po selftrain", e.what());
   }
   SelfTrainOptions& options = cmd.options;
-  options.pipeline.corrector.solver = ParseCorrectorSolver(cmd.solver);
-  options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
-  const bool auto_eps_oc = cmd.eps_oc_text == "auto";
-  if (!cmd.eps_oc_text.empty() && !auto_eps_oc) options.pipeline.certificate.eps_oc = ParseThreshold(cmd.eps_oc_text, object.diameter(), "--eps-oc");
-  if (!cmd.delta_nd_text.empty()) options.pipeline.certificate.delta_nd = ParseThreshold(cmd.delta_nd_text, object.diameter(), "--delta-nd");
-  ApplyRobustOptions(cmd.robust, &options.pipeline);
+  ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
+  options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
+  ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
   options.checkpoint_path = cmd.output_path + ".ckpt";
   try {
     options.Check();
@@ -76,16 +72,12 @@ int Run(SelftrainCommand cmd) {
   if (dataset.entries.size() < 2) throw InputError(cmd.data_dir, "need at least 2 clouds to self-train");
   const std::vector<PointSet> clouds = LoadDatasetClouds(dataset, "loading");
   std::string eps_oc_evidence;
-  if (auto_eps_oc) {
-    // The paper's remark on tuning eps_oc: sensor noise + sampling density of
-    // B̂ (Theorem 12), and the oc distances of the sim-trained detector +
-    // corrector on the unlabelled clouds themselves.
-    const CertifiedFraction initial = MeasureCertified(object, clouds, *detector, options.pipeline);
-    std::vector<double> oc_distances;
-    for (const auto& estimate : initial.estimates) {
-      if (estimate.ok()) oc_distances.push_back(estimate.certificate.oc.budget_distance);
-    }
-    const AutoEpsOcResult chosen = EstimateEpsOc(object, clouds, AutoEpsOcOptions{}, &oc_distances);
+  if (cmd.thresholds.auto_eps_oc()) {
+    // --eps-oc auto (CertifyBatch decides it): from the unlabelled clouds and
+    // the oc distances of the sim-trained detector + corrector on them.
+    const CertifiedFraction initial =
+        MeasureCertified(object, clouds, *detector, options.pipeline, /*auto_eps_oc=*/true);
+    const AutoEpsOcResult& chosen = *initial.auto_eps_oc;
     options.pipeline.certificate.eps_oc = chosen.eps_oc;
     eps_oc_evidence = chosen.ToJson();
     std::fprintf(stderr, "c3po selftrain: --eps-oc auto = %.6g (%s; eps_w = %.4g, eps_s = %.4g)\n", chosen.eps_oc,
@@ -98,7 +90,8 @@ int Run(SelftrainCommand cmd) {
                "%s, %d epochs, batch %d, %s lr %g\n",
                clouds.size(), object.name().c_str(), options.pipeline.certificate.eps_oc,
                options.pipeline.certificate.delta_nd, object.diameter(),
-               DescribeRobustOptions(options.pipeline).c_str(), options.epochs, options.batch,
+               DescribeRobust(options.pipeline.certificate, options.pipeline.corrector).c_str(), options.epochs,
+               options.batch,
                cmd.optimizer.c_str(), cmd.lr);
   ProgressBar progress("selftrain", 1);
   const SelfTrainResult result = SelfTrain(
@@ -147,12 +140,10 @@ RunFunction SetupSelftrain(CLI::App& command) {
   command.add_option("--optimizer", cmd->optimizer, "adam or sgd");
   command.add_option("--val-fraction", o.validation_fraction, "Held-out fraction of the unlabelled clouds");
   command.add_option("--stop-at", o.stop_at_percent_oc, "Stop when this % of the held-out clouds is observably correct");
-  command.add_option("--eps-oc", cmd->eps_oc_text,
-                     "Observable-correctness threshold: distance, fraction of d (3%d) or auto (estimated from the clouds)");
-  command.add_option("--delta-nd", cmd->delta_nd_text, "Non-degeneracy threshold");
-  command.add_option("--solver", cmd->solver, "Corrector solver: fast or gd");
+  AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kAllowed);
+  AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);
-  command.add_option("--seed", o.seed, "Seed (split, shuffling)");
+  AddSeedOption(command, &o.seed, "split, shuffling");
   command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt");
   return [cmd]() { return Run(*cmd); };
 }

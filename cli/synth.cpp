@@ -12,7 +12,7 @@
 #include "c3po/object/object_io.hpp"
 #include "c3po/synth/synth.hpp"
 #include "command.hpp"
-#include "common.hpp"
+#include "progress_bar.hpp"
 
 namespace c3po::cli {
 namespace {

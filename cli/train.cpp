@@ -5,12 +5,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "c3po/io/dataset.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/io/dataset.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/pointnet.hpp"
 #include "command.hpp"
-#include "common.hpp"
+#include "progress_bar.hpp"
 #include "training_common.hpp"
 
 namespace c3po::cli {

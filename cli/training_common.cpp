@@ -7,7 +7,7 @@
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/parallel.hpp"
-#include "common.hpp"
+#include "progress_bar.hpp"
 
 namespace c3po::cli {
 

@@ -83,7 +83,7 @@ std::unique_ptr<Detector> CreateDetector(const std::string& name, const ObjectMo
 
 std::unique_ptr<Detector> LoadDetectorModel(const std::string& path, const ObjectModel& object) {
   EnsureBuiltins();
-  const std::string detector = ReadModelDetectorName(path);
+  const std::string detector = ReadModelHeader(path).detector;
   ModelLoader loader;
   {
     std::lock_guard<std::mutex> lock(RegistryMutex());

@@ -14,8 +14,5 @@ using ModelLoader =
 void RegisterModelLoader(const DetectorInfo& info, ModelLoader loader);
 // Registers svd, pointnet (when built), ...; called once on first registry use.
 void RegisterBuiltinDetectors();
-// Reads the "detector" field of a model file's JSON header line. Throws
-// InputError("path: ...") when the file is not a c3po model.
-std::string ReadModelDetectorName(const std::string& path);
 
 }  // namespace c3po

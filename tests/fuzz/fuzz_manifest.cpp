@@ -1,6 +1,6 @@
 // libFuzzer target: c3po::ParseManifestLine on one arbitrary line.
-#include "c3po/io/dataset.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/io/dataset.hpp"
 #include "fuzz_common.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

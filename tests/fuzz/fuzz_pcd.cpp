@@ -1,6 +1,6 @@
 // libFuzzer target: c3po::ParseCloud on arbitrary bytes as PCD.
-#include "c3po/io/cloud_io.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/io/cloud_io.hpp"
 #include "fuzz_common.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

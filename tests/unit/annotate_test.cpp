@@ -11,10 +11,10 @@
 #include "c3po/authoring/annotate.hpp"
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
-#include "c3po/io/mesh_io.hpp"
-#include "c3po/web/annotation_page.hpp"
-#include "c3po/object/object_io.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/web/annotation_page.hpp"
 #include "test_helpers.hpp"
 
 namespace {

@@ -5,11 +5,11 @@
 
 #include <limits>
 
+#include "c3po/base/error.hpp"
+#include "c3po/base/random.hpp"
+#include "c3po/geometry/mesh.hpp"
 #include "c3po/method/auto_threshold.hpp"
 #include "c3po/method/certificate.hpp"
-#include "c3po/base/error.hpp"
-#include "c3po/geometry/mesh.hpp"
-#include "c3po/base/random.hpp"
 #include "test_objects.hpp"
 
 using namespace c3po;

@@ -1,8 +1,8 @@
 // Certificates against hand-built cases with known answers.
 #include <doctest/doctest.h>
 
-#include "c3po/method/certificate.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/method/certificate.hpp"
 #include "test_objects.hpp"
 
 using namespace c3po;

@@ -10,9 +10,9 @@
 #include <limits>
 
 #include "c3po/base/atomic_file.hpp"
-#include "c3po/io/cloud_io.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/io/cloud_io.hpp"
 #include "test_helpers.hpp"
 
 namespace {

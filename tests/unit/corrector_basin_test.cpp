@@ -5,9 +5,9 @@
 // the restarts also solve one that gd does not.)
 #include <doctest/doctest.h>
 
-#include "c3po/method/corrector.hpp"
 #include "c3po/eval/metrics.hpp"
 #include "c3po/geometry/registration.hpp"
+#include "c3po/method/corrector.hpp"
 #include "c3po/synth/synth.hpp"
 #include "test_objects.hpp"
 

@@ -3,9 +3,9 @@
 // reproduces its result), as libc3po/eval/bench/pytorch_corrector_gd.py relies on.
 #include <doctest/doctest.h>
 
-#include "c3po/method/certificate.hpp"
 #include "c3po/eval/corrector_benchmark.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/method/certificate.hpp"
 #include "c3po/synth/synth.hpp"
 #include "test_helpers.hpp"
 #include "test_objects.hpp"

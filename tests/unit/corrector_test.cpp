@@ -2,10 +2,10 @@
 // truth from perturbed keypoints; the fast solver vs the reference gd.
 #include <doctest/doctest.h>
 
-#include "c3po/method/corrector.hpp"
-#include "c3po/eval/metrics.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/eval/metrics.hpp"
 #include "c3po/geometry/registration.hpp"
+#include "c3po/method/corrector.hpp"
 #include "test_objects.hpp"
 
 using namespace c3po;

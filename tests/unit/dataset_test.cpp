@@ -9,10 +9,10 @@
 #include <thread>
 
 #include "c3po/base/atomic_file.hpp"
-#include "c3po/io/cloud_io.hpp"
-#include "c3po/io/dataset.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/io/cloud_io.hpp"
+#include "c3po/io/dataset.hpp"
 #include "test_helpers.hpp"
 
 namespace fs = std::filesystem;

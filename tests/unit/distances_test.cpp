@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "c3po/geometry/distances.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/geometry/distances.hpp"
 
 namespace {
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "c3po/base/random.hpp"
 #include "c3po/io/dataset.hpp"
 #include "c3po/object/object_model.hpp"
-#include "c3po/base/random.hpp"
 #include "test_objects.hpp"
 
 namespace c3po::test {

@@ -7,10 +7,10 @@
 #include <limits>
 
 #include "asymmetric_object.hpp"
+#include "c3po/base/random.hpp"
 #include "c3po/geometry/mesh.hpp"
 #include "c3po/method/pipeline.hpp"
 #include "c3po/plugins/svd_detector.hpp"
-#include "c3po/base/random.hpp"
 
 using namespace c3po;
 

@@ -7,10 +7,10 @@
 #include <limits>
 
 #include "asymmetric_object.hpp"
+#include "c3po/base/random.hpp"
+#include "c3po/eval/metrics.hpp"
 #include "c3po/io/mesh_io.hpp"
 #include "c3po/method/icp.hpp"
-#include "c3po/eval/metrics.hpp"
-#include "c3po/base/random.hpp"
 #include "test_helpers.hpp"
 
 using namespace c3po;

@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "c3po/base/error.hpp"
 #include "c3po/authoring/indicators.hpp"
-#include "c3po/object/object_io.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/object/object_io.hpp"
 #include "test_helpers.hpp"
 #include "test_objects.hpp"
 

@@ -7,8 +7,8 @@
 #include <set>
 #include <vector>
 
-#include "c3po/geometry/kdtree.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/geometry/kdtree.hpp"
 
 namespace {
 

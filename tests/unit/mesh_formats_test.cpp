@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "c3po/base/error.hpp"
-#include "c3po/geometry/mesh.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/geometry/mesh.hpp"
 #include "c3po/io/mesh_io.hpp"
 #include "test_helpers.hpp"
 

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "c3po/base/error.hpp"
-#include "c3po/eval/metrics.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/eval/metrics.hpp"
 
 namespace {
 

@@ -8,8 +8,8 @@
 #include <set>
 #include <stdexcept>
 
-#include "c3po/object/object_model.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace {
 

@@ -8,9 +8,9 @@
 
 #include "asymmetric_object.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/base/random.hpp"
 #include "c3po/plugins/registry.hpp"
 #include "c3po/plugins/svd_detector.hpp"
-#include "c3po/base/random.hpp"
 #include "test_helpers.hpp"
 
 using namespace c3po;

@@ -13,8 +13,8 @@
 
 #include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
-#include "c3po/object/object_io.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/object/object_io.hpp"
 #include "test_helpers.hpp"
 
 #if __has_include(<c3po/plugins/pointnet.hpp>)

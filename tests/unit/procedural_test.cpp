@@ -6,10 +6,10 @@
 #include <set>
 #include <sstream>
 
-#include "c3po/object/object_io.hpp"
-#include "c3po/object/procedural.hpp"
 #include "c3po/base/random.hpp"
 #include "c3po/geometry/render.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/object/procedural.hpp"
 #include "test_helpers.hpp"
 
 namespace {

@@ -8,10 +8,10 @@
 #include <tuple>
 
 #include "c3po/base/error.hpp"
-#include "c3po/io/mesh_io.hpp"
-#include "c3po/object/procedural.hpp"
 #include "c3po/base/random.hpp"
 #include "c3po/geometry/render.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/object/procedural.hpp"
 #include "test_helpers.hpp"
 
 namespace {

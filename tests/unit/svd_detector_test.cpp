@@ -7,11 +7,11 @@
 
 #include "asymmetric_object.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/base/random.hpp"
 #include "c3po/eval/metrics.hpp"
+#include "c3po/geometry/render.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/svd_detector.hpp"
-#include "c3po/base/random.hpp"
-#include "c3po/geometry/render.hpp"
 #include "test_helpers.hpp"
 // Internal to the svd plugin (linked through c3po::plugins).
 #include "../../plugins/svd/src/distance_grid.hpp"

@@ -10,9 +10,9 @@
 #include <sstream>
 #include <tuple>
 
-#include "c3po/io/dataset.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
+#include "c3po/io/dataset.hpp"
 #include "c3po/io/mesh_io.hpp"
 #include "c3po/object/procedural.hpp"
 #include "c3po/synth/synth.hpp"

@@ -8,9 +8,9 @@
 
 #include "c3po/authoring/annotate.hpp"
 #include "c3po/base/error.hpp"
-#include "c3po/geometry/kdtree.hpp"
 #include "c3po/base/parallel.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/geometry/kdtree.hpp"
 
 namespace c3po {
 namespace {

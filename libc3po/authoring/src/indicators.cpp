@@ -7,10 +7,10 @@
 #include <cstdlib>
 #include <set>
 
-#include "c3po/method/certificate.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
 #include "c3po/base/parallel.hpp"
+#include "c3po/method/certificate.hpp"
 
 namespace c3po {
 namespace {

@@ -7,8 +7,8 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 
-#include "c3po/base/error.hpp"
 #include "c3po/authoring/indicators.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
 #include "c3po/base/parallel.hpp"
 

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "c3po/method/certificate.hpp"
-#include "c3po/base/error.hpp"
 #include "c3po/authoring/indicators.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/method/certificate.hpp"
 
 namespace c3po {
 namespace {

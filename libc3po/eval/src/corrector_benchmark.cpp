@@ -11,10 +11,10 @@
 
 #include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
-#include "c3po/eval/metrics.hpp"
 #include "c3po/base/parallel.hpp"
-#include "c3po/geometry/registration.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/eval/metrics.hpp"
+#include "c3po/geometry/registration.hpp"
 #include "c3po/synth/stray_points.hpp"
 #include "c3po/synth/synth.hpp"
 

@@ -2,16 +2,14 @@
 #include "c3po/eval/evaluation.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include "c3po/method/certificate.hpp"
 #include "c3po/base/error.hpp"
-#include "c3po/base/interrupt.hpp"
-#include "c3po/base/parallel.hpp"
+#include "c3po/method/certificate.hpp"
+#include "c3po/method/certify_batch.hpp"
 
 namespace c3po {
 namespace {
@@ -66,6 +64,7 @@ SampleResult FromEstimate(std::size_t index, const std::string& cloud, const Pos
   sample.oc = estimate.certificate.oc.passed;
   sample.nd = estimate.certificate.nd.passed;
   sample.oc_distance = estimate.certificate.oc.max_point_distance;
+  sample.outlier_indices = estimate.certificate.oc.outlier_indices;
   sample.milliseconds = estimate.milliseconds;
   return sample;
 }
@@ -93,40 +92,49 @@ SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
   sample.oc = certificate.oc.passed;
   sample.nd = certificate.nd.passed;
   sample.oc_distance = certificate.oc.max_point_distance;
+  sample.outlier_indices = certificate.oc.outlier_indices;
   sample.milliseconds = registration.milliseconds +
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return sample;
 }
 
-// Runs one detector's stages on one (loaded) cloud, writing slot `i` of `out`.
-void EvaluateCloud(const ObjectModel& object, const Dataset& dataset, std::size_t i,
-                   const PointSet& cloud, const EvaluatedDetector& detector,
-                   const EvaluationOptions& options, DetectorResults* out) {
-  const DatasetEntry& entry = dataset.entries[i];
-  PointSet detected;
-  try {
-    detected = detector.detector ? detector.detector->Detect(cloud) : *entry.detected_keypoints;
-    if (detected.cols() != object.num_keypoints()) {
-      throw InputError("detector returned " + std::to_string(detected.cols()) +
-                       " keypoints, the object has " + std::to_string(object.num_keypoints()));
+// One detector on every cloud: CertifyBatch certifies the corrected estimate
+// (and, for a detector that is not self-trained, the plain registration T(ỹ));
+// the visitor adds "+ ICP" while the cloud is in memory and scores every
+// stage against the ground truth. Clouds that could not be read or whose
+// detection failed are failures of every stage.
+DetectorResults EvaluateDetector(const ObjectModel& object, const Dataset& dataset,
+                                 const std::vector<CloudSource>& sources, const EvaluatedDetector& detector,
+                                 const EvaluationOptions& options, const ProgressCallback& progress) {
+  const std::size_t count = sources.size();
+  DetectorResults out(kStages, std::vector<SampleResult>(count));
+  CertifyBatchOptions batch;
+  batch.pipeline = options.pipeline;
+  batch.pipeline.correct = true;
+  batch.also_uncorrected = !detector.self_trained;
+  const auto visit = [&](std::size_t i, const PointSet& cloud, CloudOutcome* outcome) {
+    const std::string& name = dataset.entries[i].cloud;
+    const Pose& truth = *dataset.entries[i].pose;
+    if (outcome->uncorrected) {
+      out[kRegistration][i] = FromEstimate(i, name, *outcome->uncorrected);
+      ScoreAgainstTruth(object, truth, options, &out[kRegistration][i]);
+      if (options.run_icp) {
+        out[kIcp][i] = RefineAndCertify(object, cloud, out[kRegistration][i], options);
+        ScoreAgainstTruth(object, truth, options, &out[kIcp][i]);
+      }
     }
-  } catch (const std::exception& e) {
-    for (int s = 0; s < kStages; ++s) (*out)[s][i] = Failure(i, entry.cloud, std::string("detector: ") + e.what());
-    return;
+    out[kCorrected][i] = FromEstimate(i, name, outcome->estimate);
+    ScoreAgainstTruth(object, truth, options, &out[kCorrected][i]);
+  };
+  const CertifyBatchResult result = CertifyBatch(object, sources, detector.detector, batch, progress, visit);
+  for (std::size_t i = 0; i < count; ++i) {
+    const CloudOutcome& outcome = result.outcomes[i];
+    if (outcome.processed()) continue;
+    const std::string why =
+        outcome.failure == CloudOutcome::Failure::kDetect ? "detector: " + outcome.error : outcome.error;
+    for (int s = 0; s < kStages; ++s) out[s][i] = Failure(i, dataset.entries[i].cloud, why);
   }
-  PipelineOptions pipeline = options.pipeline;
-  if (!detector.self_trained) {
-    pipeline.correct = false;
-    (*out)[kRegistration][i] = FromEstimate(i, entry.cloud, EstimateAndCertify(object, cloud, detected, pipeline));
-    ScoreAgainstTruth(object, *entry.pose, options, &(*out)[kRegistration][i]);
-    if (options.run_icp) {
-      (*out)[kIcp][i] = RefineAndCertify(object, cloud, (*out)[kRegistration][i], options);
-      ScoreAgainstTruth(object, *entry.pose, options, &(*out)[kIcp][i]);
-    }
-  }
-  pipeline.correct = true;
-  (*out)[kCorrected][i] = FromEstimate(i, entry.cloud, EstimateAndCertify(object, cloud, detected, pipeline));
-  ScoreAgainstTruth(object, *entry.pose, options, &(*out)[kCorrected][i]);
+  return out;
 }
 
 void CheckDataset(const Dataset& dataset, const std::vector<EvaluatedDetector>& detectors) {
@@ -306,28 +314,15 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
   if (detectors.empty()) throw std::invalid_argument("Evaluate: no detectors");
   CheckDataset(dataset, detectors);
   const std::size_t count = dataset.entries.size();
-  std::vector<DetectorResults> results(detectors.size(),
-                                       DetectorResults(kStages, std::vector<SampleResult>(count)));
-  std::atomic<std::size_t> done{0};
-  ParallelFor(0, static_cast<int>(count), [&](int i) {
-    ThrowIfInterrupted();
-    const std::string& name = dataset.entries[i].cloud;
-    PointSet cloud;
-    std::string load_error;
-    try {
-      cloud = dataset.LoadCloud(i);
-    } catch (const std::exception& e) {
-      load_error = e.what();
-    }
-    for (std::size_t d = 0; d < detectors.size(); ++d) {
-      if (!load_error.empty()) {
-        for (int s = 0; s < kStages; ++s) results[d][s][i] = Failure(i, name, load_error);
-        continue;
-      }
-      EvaluateCloud(object, dataset, i, cloud, detectors[d], options, &results[d]);
-    }
-    if (progress) progress(++done, count);
-  });
+  const std::vector<CloudSource> sources = DatasetSources(dataset);
+  std::vector<DetectorResults> results;
+  for (std::size_t d = 0; d < detectors.size(); ++d) {
+    // Progress over all detectors' clouds, reported as clouds of the dataset.
+    const ProgressCallback per_detector = [&, d](std::size_t done, std::size_t) {
+      if (progress) progress((d * count + done) / detectors.size(), count);
+    };
+    results.push_back(EvaluateDetector(object, dataset, sources, detectors[d], options, per_detector));
+  }
 
   Evaluation evaluation;
   evaluation.object_name = object.name();

@@ -10,8 +10,8 @@
 #include <optional>
 
 #include "c3po/base/atomic_file.hpp"
-#include "c3po/io/cloud_io.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/io/cloud_io.hpp"
 #include "cloud_io_internal.hpp"
 #include "mesh_io_internal.hpp"
 

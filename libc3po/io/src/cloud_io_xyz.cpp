@@ -1,8 +1,8 @@
 // XYZ text point clouds: one point per line, at least three columns separated
 // by whitespace or commas (extra columns ignored), '#' starts a comment.
 #include "c3po/base/atomic_file.hpp"
-#include "c3po/io/cloud_io.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/io/cloud_io.hpp"
 #include "cloud_io_internal.hpp"
 
 namespace c3po {

@@ -18,8 +18,8 @@
 #include <stdexcept>
 
 #include "c3po/base/atomic_file.hpp"
-#include "c3po/io/cloud_io.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/io/cloud_io.hpp"
 #include "cloud_io_internal.hpp"
 
 namespace c3po {

@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "c3po/base/error.hpp"
+#include "c3po/base/parallel.hpp"
 #include "c3po/geometry/kdtree.hpp"
 #include "c3po/geometry/mesh.hpp"
-#include "c3po/base/parallel.hpp"
 
 namespace c3po {
 namespace {

@@ -5,8 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "c3po/method/corrector.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/method/corrector.hpp"
 
 namespace c3po {
 

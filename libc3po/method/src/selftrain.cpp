@@ -29,19 +29,27 @@ void SelfTrainOptions::Check() const {
 }
 
 CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<PointSet>& clouds,
-                                   const Detector& detector, const PipelineOptions& options) {
+                                   const Detector& detector, const PipelineOptions& options, bool auto_eps_oc) {
   CertifiedFraction result;
   if (clouds.empty()) return result;
-  const std::vector<PointSet> detected = detector.DetectBatch(clouds);
-  result.estimates.resize(clouds.size());
-  ParallelFor(0, static_cast<int>(clouds.size()), [&](int i) {
-    result.estimates[i] = EstimateAndCertify(object, clouds[i], detected[i], options);
-  });
-  double oc = 0, certified = 0, iterations = 0, squared_error = 0;
+  // The detector sees the clouds as one batch (DetectBatch); CertifyBatch
+  // certifies them with the detections as given keypoints.
+  CertifyBatchOptions batch;
+  batch.pipeline = options;
+  batch.auto_eps_oc = auto_eps_oc;
+  CertifyBatchResult certified =
+      CertifyBatch(object, InMemorySources(clouds, detector.DetectBatch(clouds)), nullptr, batch);
+  result.auto_eps_oc = std::move(certified.auto_eps_oc);
+  result.estimates.reserve(clouds.size());
+  for (CloudOutcome& outcome : certified.outcomes) {
+    if (!outcome.processed()) throw InputError("selftrain", "detector: " + outcome.error);
+    result.estimates.push_back(std::move(outcome.estimate));
+  }
+  double oc = 0, certified_count = 0, iterations = 0, squared_error = 0;
   for (const auto& e : result.estimates) {
     const bool observably_correct = e.ok() && e.certificate.oc.passed;
     oc += observably_correct;
-    certified += e.certified();
+    certified_count += e.certified();
     iterations += e.correction.iterations;
     if (observably_correct) {
       squared_error += (e.detected_keypoints - e.keypoints).squaredNorm() / e.keypoints.cols();
@@ -50,7 +58,7 @@ CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<
   result.detection_error = oc > 0 ? std::sqrt(squared_error / oc) : 0.0;
   const double n = static_cast<double>(clouds.size());
   result.percent_oc = 100.0 * oc / n;
-  result.percent_certified = 100.0 * certified / n;
+  result.percent_certified = 100.0 * certified_count / n;
   result.mean_iterations = iterations / n;
   return result;
 }
@@ -118,18 +126,15 @@ struct EpochStats {
 EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clouds,
                     const std::vector<int>& order, TrainableDetector& detector,
                     const SelfTrainOptions& options, const ProgressCallback& progress,
-                    std::size_t progress_offset, std::size_t progress_total) {
+                    std::size_t progress_offset, std::size_t progress_total, int epoch) {
   EpochStats stats;
   for (std::size_t start = 0; start < order.size(); start += options.batch) {
+    HoldForInterruptAt(epoch, static_cast<long long>(start / options.batch));
     ThrowIfInterrupted();
     const std::size_t end = std::min(order.size(), start + options.batch);
     std::vector<PointSet> batch;
     for (std::size_t k = start; k < end; ++k) batch.push_back(clouds[order[k]]);
-    const std::vector<PointSet> detected = detector.DetectBatch(batch);
-    std::vector<PoseEstimate> estimates(batch.size());
-    ParallelFor(0, static_cast<int>(batch.size()), [&](int i) {
-      estimates[i] = EstimateAndCertify(object, batch[i], detected[i], options.pipeline);
-    });
+    const std::vector<PoseEstimate> estimates = MeasureCertified(object, batch, detector, options.pipeline).estimates;
     std::vector<PointSet> certified_clouds, targets;
     for (std::size_t i = 0; i < batch.size(); ++i) {
       stats.iterations += estimates[i].correction.iterations;
@@ -198,7 +203,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     const auto start = std::chrono::steady_clock::now();
     const std::vector<int> order = Shuffled(train, Rng::ForItem(options.seed, epoch));
     const EpochStats stats = RunEpoch(object, clouds, order, detector, options, progress,
-                                      train.size() * (epoch - 1), progress_total);
+                                      train.size() * (epoch - 1), progress_total, epoch);
     const CertifiedFraction held_out = MeasureCertified(object, validation, detector, options.pipeline);
     SelfTrainEpochLog log;
     log.epoch = epoch;

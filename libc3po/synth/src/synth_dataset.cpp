@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "c3po/io/dataset.hpp"
 #include "c3po/base/interrupt.hpp"
 #include "c3po/base/parallel.hpp"
+#include "c3po/io/dataset.hpp"
 #include "c3po/synth/synth.hpp"
 
 namespace c3po {

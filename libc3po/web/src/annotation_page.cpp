@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "annotation_page_html.hpp"
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 #include "embedded_resources.hpp"
-#include "annotation_page_html.hpp"
 
 namespace c3po {
 namespace {

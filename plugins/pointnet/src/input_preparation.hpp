@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "c3po/method/detector.hpp"
 #include "c3po/base/random.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/method/detector.hpp"
 #include "tiny_dnn_parts.hpp"
 
 namespace c3po::pointnet {

@@ -4,8 +4,8 @@
 #include <stdexcept>
 
 #include "c3po/base/parallel.hpp"
-#include "c3po/plugins/pointnet.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/plugins/pointnet.hpp"
 
 namespace c3po {
 namespace {

@@ -194,6 +194,7 @@ PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train
     const std::vector<std::size_t> order = Shuffled(split.train.size(), &shuffle_rng);
     double loss_sum = 0.0;
     for (std::size_t begin = 0; begin < order.size(); begin += static_cast<std::size_t>(options.batch)) {
+      HoldForInterruptAt(epoch, static_cast<long long>(begin / static_cast<std::size_t>(options.batch)));
       ThrowIfInterrupted();
       const std::size_t count = std::min(order.size() - begin, static_cast<std::size_t>(options.batch));
       tiny_dnn::tensor_t inputs(count), targets(count);

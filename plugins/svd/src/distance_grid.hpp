@@ -5,8 +5,8 @@
 // pose hypotheses at a few nanoseconds per point instead of a k-d tree query.
 #include <vector>
 
-#include "c3po/geometry/kdtree.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/geometry/kdtree.hpp"
 
 namespace c3po {
 

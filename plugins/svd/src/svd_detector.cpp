@@ -8,8 +8,8 @@
 #include <stdexcept>
 
 #include "c3po/base/error.hpp"
-#include "c3po/method/icp.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/method/icp.hpp"
 #include "distance_grid.hpp"
 
 namespace c3po {

@@ -30,6 +30,15 @@ std::unique_ptr<Detector> CreateDetector(const std::string& name, const ObjectMo
 // Loads a trained model file (self-describing: detector name, object, weights).
 // Throws InputError("path: ...") when it is unreadable or for another object.
 std::unique_ptr<Detector> LoadDetectorModel(const std::string& path, const ObjectModel& object);
+// The JSON header line of a model file: {"magic": "c3po-model", "detector":
+// NAME, ...}, read with a bound on its length and checked (magic, detector
+// name). Throws InputError("path: ...") when the file is not a c3po model.
+struct ModelHeader {
+  std::string detector;          // "detector"
+  bool self_trained = false;     // "selftrained" (or "self_trained") is true
+  std::string json;              // the whole header
+};
+ModelHeader ReadModelHeader(const std::string& path);
 // Loads a detector plugin from a shared library and registers it. Throws
 // InputError("path: ...") when it cannot be loaded or lacks the entry point.
 void LoadPlugin(const std::string& path);

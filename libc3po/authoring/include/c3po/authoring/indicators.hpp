@@ -24,11 +24,11 @@
 #include <string>
 #include <vector>
 
+#include "c3po/base/types.hpp"
+#include "c3po/geometry/render.hpp"
 #include "c3po/io/dataset.hpp"
 #include "c3po/method/icp.hpp"
 #include "c3po/object/object_model.hpp"
-#include "c3po/geometry/render.hpp"
-#include "c3po/base/types.hpp"
 
 namespace c3po {
 

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "c3po/method/corrector.hpp"
-#include "c3po/method/certificate.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/method/certificate.hpp"
+#include "c3po/method/corrector.hpp"
 #include "c3po/method/detector.hpp"
 #include "c3po/object/object_model.hpp"
 

@@ -3,8 +3,8 @@
 #include <string>
 #include <vector>
 
-#include "c3po/geometry/kdtree.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/geometry/kdtree.hpp"
 
 namespace c3po {
 

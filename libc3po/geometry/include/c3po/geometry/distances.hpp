@@ -1,7 +1,7 @@
 #pragma once
 // Point-set distances (batch, both cores).
-#include "c3po/geometry/kdtree.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/geometry/kdtree.hpp"
 
 namespace c3po {
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "c3po/geometry/mesh.hpp"
 #include "c3po/base/random.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/geometry/mesh.hpp"
 
 namespace c3po {
 

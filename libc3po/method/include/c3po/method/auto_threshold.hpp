@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
+#include "c3po/base/types.hpp"
 #include "c3po/method/certificate.hpp"
 #include "c3po/object/object_model.hpp"
-#include "c3po/base/types.hpp"
 
 namespace c3po {
 
@@ -84,14 +84,6 @@ NoiseEstimate EstimateSensorNoise(const std::vector<PointSet>& clouds, const Aut
 AutoEpsOcResult EstimateEpsOc(const ObjectModel& object, const std::vector<PointSet>& clouds,
                               const AutoEpsOcOptions& options,
                               const std::vector<double>* oc_distances = nullptr);
-
-// The oc decision from its evidence with another threshold (the distances do
-// not depend on eps_oc): lets `certify --eps-oc auto` decide after seeing every
-// cloud's oc distance. Recomputes the outlier evidence under the same budget
-// (oc->max_outliers); defined in certificate.cpp. The nd_m evidence depends on
-// the accepted points, so callers re-run CheckNonDegeneracy when m > 0.
-void RethresholdObservableCorrectness(ObservableCorrectness* oc, double eps_oc,
-                                      bool check_keypoint_agreement = true);
 
 // q in [0, 1]: linear interpolation between order statistics; 0 when empty.
 double SampleQuantile(std::vector<double> values, double q);

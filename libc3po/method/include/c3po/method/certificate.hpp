@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "c3po/base/types.hpp"
 #include "c3po/method/local_nondegeneracy.hpp"
 #include "c3po/object/object_model.hpp"
-#include "c3po/base/types.hpp"
 
 namespace c3po {
 
@@ -93,6 +93,13 @@ ObservableCorrectness CheckObservableCorrectness(const ObjectModel& object, cons
                                                  const Pose& scene_from_model,
                                                  const PointSet& corrected_keypoints,
                                                  const CertificateOptions& options);
+// The oc_m decision and its outlier evidence from the per-point distances
+// with another threshold (the distances do not depend on eps_oc), under the
+// same budget (oc->max_outliers). The nd evidence depends on the accepted
+// points: callers that change eps_oc decide nd again (CheckNonDegeneracy).
+void RethresholdObservableCorrectness(ObservableCorrectness* oc, double eps_oc,
+                                      bool check_keypoint_agreement = true);
+
 // nd_m given the oc evidence of the same cloud and pose (accepted points).
 NonDegeneracy CheckNonDegeneracy(const ObjectModel& object, const PointSet& cloud,
                                  const Pose& scene_from_model, const ObservableCorrectness& oc,

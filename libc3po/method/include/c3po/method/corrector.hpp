@@ -13,9 +13,9 @@
 // solver reproduces the reference's gradient descent in keypoint space.
 #include <string>
 
-#include "c3po/object/object_model.hpp"
-#include "c3po/geometry/registration.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/geometry/registration.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po {
 

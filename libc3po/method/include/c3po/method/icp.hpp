@@ -9,8 +9,8 @@
 #include <limits>
 #include <string>
 
-#include "c3po/object/object_model.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po {
 

@@ -7,12 +7,15 @@
 // "move the detected keypoints toward the fixed corrected keypoints" on
 // certified samples: exactly this regression onto pseudo-labels.
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "c3po/method/auto_threshold.hpp"
+#include "c3po/method/certify_batch.hpp"
 #include "c3po/method/detector.hpp"
-#include "c3po/object/object_model.hpp"
 #include "c3po/method/pipeline.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po {
 
@@ -69,8 +72,14 @@ struct CertifiedFraction {
   // (ties in % oc are broken by it when keeping the best epoch).
   double detection_error = 0.0;
   std::vector<PoseEstimate> estimates;
+  std::optional<AutoEpsOcResult> auto_eps_oc;   // with auto_eps_oc: the decision (estimates re-decided with it)
 };
+// Detects on all clouds at once (DetectBatch) and certifies them through
+// CertifyBatch (certify_batch.hpp). `auto_eps_oc`: the `--eps-oc auto`
+// decision of CertifyBatch on these clouds (self-training takes eps_oc from
+// the clouds and the sim-trained detector before it starts).
 CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<PointSet>& clouds,
-                                   const Detector& detector, const PipelineOptions& options);
+                                   const Detector& detector, const PipelineOptions& options,
+                                   bool auto_eps_oc = false);
 
 }  // namespace c3po

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "c3po/base/types.hpp"
 #include "c3po/geometry/kdtree.hpp"
 #include "c3po/geometry/mesh.hpp"
-#include "c3po/base/types.hpp"
 
 namespace c3po {
 

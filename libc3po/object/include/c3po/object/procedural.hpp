@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "c3po/base/types.hpp"
 #include "c3po/geometry/mesh.hpp"
 #include "c3po/object/object_model.hpp"
-#include "c3po/base/types.hpp"
 
 namespace c3po {
 

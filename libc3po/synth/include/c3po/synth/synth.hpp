@@ -31,11 +31,11 @@
 #include <utility>
 #include <vector>
 
-#include "c3po/geometry/mesh.hpp"
-#include "c3po/object/object_model.hpp"
 #include "c3po/base/random.hpp"
-#include "c3po/geometry/render.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/geometry/render.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po {
 

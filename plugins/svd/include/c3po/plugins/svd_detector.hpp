@@ -23,9 +23,9 @@
 #include <memory>
 #include <vector>
 
+#include "c3po/base/types.hpp"
 #include "c3po/method/detector.hpp"
 #include "c3po/object/object_model.hpp"
-#include "c3po/base/types.hpp"
 
 namespace c3po {
 

@@ -1,4 +1,5 @@
 // Model files start with one line of JSON: {"magic": "c3po-model", "detector": NAME, ...}.
+// The one reader of that line (registry.hpp: ReadModelHeader); bounded to 1 MiB.
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -8,7 +9,7 @@
 
 namespace c3po {
 
-std::string ReadModelDetectorName(const std::string& path) {
+ModelHeader ReadModelHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot open model file");
   std::string line;
@@ -32,7 +33,13 @@ std::string ReadModelDetectorName(const std::string& path) {
   if (!header.contains("detector") || !header["detector"].is_string()) {
     throw InputError(path, "model header has no detector name");
   }
-  return header["detector"].get<std::string>();
+  ModelHeader result;
+  result.detector = header["detector"].get<std::string>();
+  for (const char* key : {"selftrained", "self_trained"}) {
+    if (header.contains(key) && header[key].is_boolean() && header[key].get<bool>()) result.self_trained = true;
+  }
+  result.json = header.dump();
+  return result;
 }
 
 }  // namespace c3po

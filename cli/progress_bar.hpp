@@ -1,6 +1,5 @@
 #pragma once
-// Small helpers shared by subcommands: terminal progress bar, threshold
-// options, printing JSON lines. No maths.
+// The terminal progress bar of long subcommands. No maths.
 #include <chrono>
 #include <cstddef>
 #include <string>
@@ -24,9 +23,5 @@ class ProgressBar {
   std::chrono::steady_clock::time_point last_draw_;
   bool finished_ = false;
 };
-
-// Installs SIGINT/SIGTERM handlers that request a cooperative interrupt
-// (c3po::RequestInterrupt); a second signal exits at once with status 130.
-void InstallInterruptHandlers();
 
 }  // namespace c3po::cli

@@ -1,23 +1,15 @@
-#include "common.hpp"
+// A progress bar on stderr when it is a terminal (progress_bar.hpp).
+#include "progress_bar.hpp"
 
 #include <unistd.h>
 
-#include <csignal>
 #include <cstdio>
 #include <mutex>
-
-#include "c3po/base/interrupt.hpp"
-#include "command.hpp"
 
 namespace c3po::cli {
 namespace {
 
 std::mutex g_progress_mutex;
-
-void HandleSignal(int) {
-  if (InterruptRequested()) _exit(130);
-  RequestInterrupt();
-}
 
 }  // namespace
 
@@ -51,14 +43,6 @@ void ProgressBar::Finish() {
   if (finished_) return;
   finished_ = true;
   if (StderrIsTerminal()) std::fprintf(stderr, "\r\033[K");
-}
-
-void InstallInterruptHandlers() {
-  struct sigaction action {};
-  action.sa_handler = HandleSignal;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
 }
 
 }  // namespace c3po::cli

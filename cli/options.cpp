@@ -1,0 +1,131 @@
+// Shared command-line options (options.hpp).
+#include "options.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+
+#include "c3po/base/error.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/plugins/registry.hpp"
+
+namespace c3po::cli {
+
+void AddThresholdOptions(CLI::App& command, ThresholdFlags* flags, AutoEpsOc auto_eps_oc) {
+  flags->auto_mode = auto_eps_oc;
+  command.add_option("--eps-oc", flags->eps_oc,
+                     auto_eps_oc == AutoEpsOc::kAllowed
+                         ? "Observable-correctness threshold: distance, fraction of d (3%d) or auto (estimated from "
+                           "the clouds; default: the object's)"
+                         : "Observable-correctness threshold: distance or fraction of d (3%d) (default: the object's)");
+  command.add_option("--delta-nd", flags->delta_nd,
+                     "Non-degeneracy threshold: distance or fraction of d (default: the object's)");
+}
+
+CertificateOptions ResolveThresholds(const ThresholdFlags& flags, const ObjectModel& object) {
+  CertificateOptions options = CertificateOptions::FromObject(object.spec());
+  if (flags.auto_eps_oc() && flags.auto_mode == AutoEpsOc::kRefused) {
+    throw InputError("--eps-oc", "'auto' is not available here (give a distance, e.g. 0.01 or 3%d)");
+  }
+  if (!flags.eps_oc.empty() && !flags.auto_eps_oc()) {
+    options.eps_oc = ParseThreshold(flags.eps_oc, object.diameter(), "--eps-oc");
+  }
+  if (!flags.delta_nd.empty()) options.delta_nd = ParseThreshold(flags.delta_nd, object.diameter(), "--delta-nd");
+  return options;
+}
+
+void AddCorrectorOptions(CLI::App& command, CorrectorFlags* flags) {
+  command.add_option("--solver", flags->solver, "Corrector solver: fast (default) or gd (the reference's)");
+  AddLossOption(command, &flags->loss);
+}
+
+void AddLossOption(CLI::App& command, std::string* loss) {
+  command.add_option("--loss", *loss, "Point-cloud loss: mean (paper, default) or max (reference code)");
+}
+
+void ResolveCorrector(const CorrectorFlags& flags, CorrectorOptions* options) {
+  options->solver = ParseCorrectorSolver(flags.solver);
+  options->loss = ParsePointCloudLoss(flags.loss);
+}
+
+void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
+  command.add_option("--max-outliers", flags->max_outliers,
+                     "Outlier budget m of the certificates: a count (10) or a percentage of each cloud's points "
+                     "(2%); default 0 = the paper");
+  command.add_option("--robust-loss", flags->robust_loss,
+                     "Robust kernel of the corrector's point-cloud term, truncated at eps_oc: none (default), "
+                     "tls (truncated least squares, GNC) or gm (Geman-McClure)");
+  command.add_option("--nd-min-eigenvalue", flags->nd_min_eigenvalue,
+                     "Local non-degeneracy threshold on the smallest generalised eigenvalue (data vs model "
+                     "point-to-plane information); 0 = local test off");
+}
+
+void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, CorrectorOptions* corrector) {
+  if (!flags.max_outliers.empty()) certificate->max_outliers = ParseOutlierBudget(flags.max_outliers);
+  corrector->robust_loss = ParseRobustLoss(flags.robust_loss);
+  if (!flags.nd_min_eigenvalue.empty()) {
+    char* end = nullptr;
+    const double value = std::strtod(flags.nd_min_eigenvalue.c_str(), &end);
+    if (*end != '\0' || !(value >= 0) || !(value < 1e6)) {
+      throw InputError("--nd-min-eigenvalue", "'" + flags.nd_min_eigenvalue + "' must be a number >= 0");
+    }
+    certificate->local_nondegeneracy = value > 0;
+    if (value > 0) certificate->local.min_eigenvalue = value;
+  }
+}
+
+std::string DescribeRobust(const CertificateOptions& certificate, const CorrectorOptions& corrector) {
+  char text[160];
+  if (certificate.local_nondegeneracy) {
+    std::snprintf(text, sizeof text, "m = %s, robust loss = %s, local nd >= %g",
+                  certificate.max_outliers.ToString().c_str(), ToString(corrector.robust_loss),
+                  certificate.local.min_eigenvalue);
+  } else {
+    std::snprintf(text, sizeof text, "m = %s, robust loss = %s, local nd off",
+                  certificate.max_outliers.ToString().c_str(), ToString(corrector.robust_loss));
+  }
+  return text;
+}
+
+std::string RobustCommandLine(const RobustFlags& flags) {
+  std::string line;
+  if (!flags.max_outliers.empty()) line += " --max-outliers " + flags.max_outliers;
+  if (flags.robust_loss != "none") line += " --robust-loss " + flags.robust_loss;
+  if (!flags.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + flags.nd_min_eigenvalue;
+  return line;
+}
+
+void AddDetectorOptions(CLI::App& command, DetectorFlags* flags, DetectorCount count) {
+  const bool many = count == DetectorCount::kMany;
+  CLI::Option* model = command.add_option(
+      "--model", flags->models,
+      many ? "Trained detector model file (row label = file stem); repeatable" : "Trained detector model file");
+  CLI::Option* detector = command.add_option(
+      "--detector", flags->detectors,
+      std::string("Detector without a model file (svd, manifest = the manifest's detected_keypoints, or a "
+                  "plugin's)") + (many ? "; repeatable" : ""));
+  CLI::Option* plugin =
+      command.add_option("--plugin", flags->plugins, "Load a detector plugin (shared library); repeatable");
+  // Each occurrence takes one value, so a positional after it stays positional.
+  for (CLI::Option* option : {model, detector, plugin}) option->allow_extra_args(false);
+}
+
+void LoadPlugins(const DetectorFlags& flags) {
+  for (const std::string& plugin : flags.plugins) LoadPlugin(plugin);
+}
+
+std::unique_ptr<Detector> MakeDetector(const std::string& model, const std::string& detector,
+                                       const ObjectModel& object) {
+  if (!model.empty()) return LoadDetectorModel(model, object);
+  if (detector == kManifestDetector) return nullptr;
+  return CreateDetector(detector, object);
+}
+
+void AddSeedOption(CLI::App& command, std::uint64_t* seed, const std::string& what) {
+  command.add_option("--seed", *seed, "Seed (" + what + ")");
+}
+
+void AddThreadsOption(CLI::App& command, int* threads, const std::string& what) {
+  command.add_option("--threads", *threads, "Worker threads (" + what + ")");
+}
+
+}  // namespace c3po::cli

@@ -1,0 +1,85 @@
+#pragma once
+// The command-line options several subcommands share, declared once and bound
+// to the library's options structs: certificate thresholds (--eps-oc,
+// --delta-nd: a distance, a fraction of d such as 3%d, or `auto` where the
+// command allows it), corrector (--solver, --loss), detector choice (--model,
+// --detector, --plugin), --seed and --threads. A new option group (camera
+// inputs, --max-outliers, ...) is one more struct + Add/Resolve pair here.
+// No maths: resolving only parses text and fills structs.
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "c3po/method/certificate.hpp"
+#include "c3po/method/corrector.hpp"
+#include "c3po/method/detector.hpp"
+#include "c3po/object/object_model.hpp"
+
+namespace c3po::cli {
+
+enum class AutoEpsOc { kRefused, kAllowed };
+// --eps-oc, --delta-nd as typed ("" = the object's value).
+struct ThresholdFlags {
+  std::string eps_oc;
+  std::string delta_nd;
+  AutoEpsOc auto_mode = AutoEpsOc::kRefused;   // set by AddThresholdOptions
+  bool auto_eps_oc() const { return eps_oc == "auto"; }
+};
+void AddThresholdOptions(CLI::App& command, ThresholdFlags* flags, AutoEpsOc auto_eps_oc);
+// The object's thresholds overridden by the flags (absolute, object units).
+// With --eps-oc auto (where allowed), eps_oc stays the object's: CertifyBatch
+// decides it. Throws InputError("--eps-oc: ...") for a bad value, and for
+// `auto` where it is refused.
+CertificateOptions ResolveThresholds(const ThresholdFlags& flags, const ObjectModel& object);
+
+// --solver, --loss.
+struct CorrectorFlags {
+  std::string solver = "fast";
+  std::string loss = "mean";
+};
+void AddCorrectorOptions(CLI::App& command, CorrectorFlags* flags);
+// --loss alone (for a command that compares several solvers).
+void AddLossOption(CLI::App& command, std::string* loss);
+// `options` with solver and loss set from the flags (InputError on bad names).
+void ResolveCorrector(const CorrectorFlags& flags, CorrectorOptions* options);
+
+// --max-outliers, --robust-loss, --nd-min-eigenvalue (issue 16): the outlier
+// budget m of oc_m / nd_m, the corrector's robust kernel, the local
+// non-degeneracy threshold. The meaning lives in the library (certificate.hpp,
+// corrector.hpp, local_nondegeneracy.hpp).
+struct RobustFlags {
+  std::string max_outliers;        // "" = the source's default (0 for ready-made clouds)
+  std::string robust_loss = "none";
+  std::string nd_min_eigenvalue;   // "" = default; 0 = local test off
+};
+void AddRobustOptions(CLI::App& command, RobustFlags* flags);
+// Fills the certificate's budget and local test and the corrector's kernel
+// (InputError naming the option on a bad value).
+void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, CorrectorOptions* corrector);
+// "m = 2%, robust loss = tls, local nd >= 0.02" for the printed summary.
+std::string DescribeRobust(const CertificateOptions& certificate, const CorrectorOptions& corrector);
+// " --max-outliers 2% --robust-loss tls" (the flags given, for a command line).
+std::string RobustCommandLine(const RobustFlags& flags);
+
+// --model, --detector, --plugin: one detector (certify) or several (eval).
+struct DetectorFlags {
+  std::vector<std::string> models;
+  std::vector<std::string> detectors;   // registry names, or "manifest"
+  std::vector<std::string> plugins;
+};
+enum class DetectorCount { kOne, kMany };
+void AddDetectorOptions(CLI::App& command, DetectorFlags* flags, DetectorCount count);
+// Loads the --plugin libraries (before any detector is made).
+void LoadPlugins(const DetectorFlags& flags);
+// kOne: exactly one of --model / --detector. nullptr for --detector manifest
+// (the manifest's detected_keypoints are the detections).
+std::unique_ptr<Detector> MakeDetector(const std::string& model, const std::string& detector,
+                                       const ObjectModel& object);
+constexpr const char* kManifestDetector = "manifest";
+
+void AddSeedOption(CLI::App& command, std::uint64_t* seed, const std::string& what);
+void AddThreadsOption(CLI::App& command, int* threads, const std::string& what);
+
+}  // namespace c3po::cli

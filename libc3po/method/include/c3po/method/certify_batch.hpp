@@ -1,0 +1,112 @@
+#pragma once
+// Batch certification: the one loop "cloud -> keypoints (detector or given)
+// -> EstimateAndCertify (pipeline.hpp) -> outcome" behind `c3po certify`,
+// `c3po eval` (evaluation.hpp) and self-training (selftrain.hpp), with
+// progress, parallelism over clouds (ParallelFor), cancellation (interrupt.hpp)
+// and the single `--eps-oc auto` decision (docs/method.md "Automatic eps_oc").
+//
+// A batch is a list of CloudSource: each yields a point cloud (read from a
+// file, a dataset entry, or already in memory) with its provenance and, when
+// known, given keypoints and the ground-truth pose. New kinds of input (depth
+// images, BOP scenes) are new CloudSource factories; the loop does not change.
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "c3po/base/types.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/method/auto_threshold.hpp"
+#include "c3po/method/detector.hpp"
+#include "c3po/method/pipeline.hpp"
+#include "c3po/object/object_model.hpp"
+
+namespace c3po {
+
+struct CloudSource {
+  std::string name;                          // how outputs name the cloud (path, manifest entry)
+  std::string path;                          // file it is read from ("" = in memory)
+  std::size_t dataset_index = 0;             // entry of its dataset (dataset sources)
+  std::function<PointSet()> load;            // reads the cloud; throws InputError naming the file
+  std::optional<PointSet> given_keypoints;   // e.g. a manifest's detected_keypoints, 3 x N
+  std::optional<Pose> scene_from_model_truth;   // ground truth, when known
+};
+
+// Cloud files given by path (named by their path).
+std::vector<CloudSource> CloudFileSources(const std::vector<std::string>& paths);
+// Every entry of a dataset (named by the manifest's "cloud"), with its
+// detected_keypoints and ground-truth pose when the manifest has them.
+std::vector<CloudSource> DatasetSources(const Dataset& dataset);
+// Clouds already in memory (named "#i"), optionally with given keypoints
+// (keypoints.size() == clouds.size() or empty). The clouds are referenced, not
+// copied: they must outlive the batch.
+std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
+                                         const std::vector<PointSet>& keypoints = {});
+
+struct CertifyBatchOptions {
+  PipelineOptions pipeline;           // corrector + certificate thresholds (absolute)
+  // --eps-oc auto: after every cloud is certified, eps_oc is estimated from
+  // the clouds and the oc distances of their estimates (EstimateEpsOc) and
+  // every oc decision is taken again with it (the distances do not depend on
+  // eps_oc). The one place that decides `auto`.
+  bool auto_eps_oc = false;
+  AutoEpsOcOptions auto_eps_oc_options;
+  // Also certify the plain registration T(ỹ) of the detected keypoints
+  // (eval's "KeyPo" rows) besides the pipeline's estimate.
+  bool also_uncorrected = false;
+  void Check() const;                 // throws std::invalid_argument / InputError
+};
+
+struct CloudOutcome {
+  enum class Failure { kNone, kLoad, kDetect };
+  Failure failure = Failure::kNone;
+  std::string error;                  // why (failure != kNone): the InputError's text
+  PointSet detected_keypoints;        // ỹ (given or detected)
+  PoseEstimate estimate;              // pipeline.correct as given
+  std::optional<PoseEstimate> uncorrected;   // also_uncorrected: T(ỹ), certified
+  bool processed() const { return failure == Failure::kNone; }
+  bool certified() const { return processed() && estimate.certified(); }
+};
+
+struct CertifyBatchResult {
+  std::vector<CloudOutcome> outcomes;        // in source order
+  CertificateOptions certificate;            // the thresholds the decisions used
+  std::optional<AutoEpsOcResult> auto_eps_oc;   // the decision and its evidence (auto_eps_oc)
+  int certified = 0, oc = 0, nd = 0, errors = 0;
+};
+
+// Called in the worker thread right after cloud `index` is certified, while
+// the cloud is in memory (eval refines with ICP there). Not called for clouds
+// that failed to load.
+using CloudVisitor = std::function<void(std::size_t index, const PointSet& cloud, CloudOutcome* outcome)>;
+
+// Certifies every source (in parallel over clouds). `detector` nullptr: every
+// source must carry given keypoints (InputError naming the first that does
+// not). A cloud that cannot be read or whose detection fails (or returns the
+// wrong number of keypoints) is a per-cloud failure, not an exception.
+// Throws Interrupted when an interrupt is requested (interrupt.hpp).
+CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<CloudSource>& sources,
+                                const Detector* detector, const CertifyBatchOptions& options,
+                                const ProgressCallback& progress = {}, const CloudVisitor& visit = {});
+
+// The JSON-lines schema of `c3po certify --json` / `-o` (docs/architecture.md
+// "Output schemas"): one object per cloud, keys in this order:
+//   cloud, R (3 rows), t, keypoints (N x 3, corrected), oc, nd, certified,
+//   oc_distance (null when not finite), keypoint_distance, nd_set,
+//   nd_set_distances, eps_oc, delta_nd, iterations, cost_before, cost_after
+//   (null when not finite), status (registration), then the outlier-robust
+//   evidence (docs/method.md "Outlier-robust certificates"): max_outliers (m
+//   for this cloud), outliers (count at >= eps_oc), outlier_indices (the first
+//   kMaxListedOutliers, ascending), outlier_indices_truncated,
+//   distance_quantiles (50/90/99/100 %, null when not finite),
+//   max_inlier_distance, keypoint_support (per keypoint), nd_set_support (per
+//   set), nd_sets, nd_local (null when the local test is off),
+//   nd_local_eigenvalue, nd_local_motion (6: rotation, translation),
+//   nd_local_rank; and last ms.
+constexpr std::size_t kMaxListedOutliers = 100;
+std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& estimate);
+// {"cloud": ..., "error": ...} for a cloud that could not be processed.
+std::string CertifyErrorJsonLine(const std::string& cloud, const std::string& error);
+
+}  // namespace c3po

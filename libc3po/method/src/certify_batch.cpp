@@ -1,0 +1,186 @@
+// Batch certification (certify_batch.hpp): the loop behind certify, eval and
+// self-training, and the one `--eps-oc auto` decision.
+#include "c3po/method/certify_batch.hpp"
+
+#include <atomic>
+#include <exception>
+#include <stdexcept>
+
+#include "c3po/base/error.hpp"
+#include "c3po/base/interrupt.hpp"
+#include "c3po/base/parallel.hpp"
+#include "c3po/io/cloud_io.hpp"
+
+namespace c3po {
+namespace {
+
+// --eps-oc auto (docs/method.md "Automatic eps_oc"): eps_oc from the clouds
+// that were processed and the oc distances of their estimates, then both
+// certificates are decided again with it. With a budget m the distance used is
+// each cloud's (m+1)-th largest point distance (budget_distance: the m
+// farthest points never set eps_oc), and nd is decided again too: nd_m and the
+// local test count only the points accepted under the new eps_oc.
+AutoEpsOcResult DecideAutoEpsOc(const ObjectModel& object, const std::vector<PointSet>& clouds,
+                                const CertifyBatchOptions& options, CertifyBatchResult* result) {
+  std::vector<PointSet> usable;
+  std::vector<double> oc_distances;
+  for (std::size_t i = 0; i < result->outcomes.size(); ++i) {
+    const CloudOutcome& outcome = result->outcomes[i];
+    if (!outcome.processed()) continue;
+    usable.push_back(clouds[i]);
+    if (outcome.estimate.ok()) oc_distances.push_back(outcome.estimate.certificate.oc.budget_distance);
+  }
+  const AutoEpsOcResult chosen = EstimateEpsOc(object, usable, options.auto_eps_oc_options, &oc_distances);
+  CertificateOptions decided = options.pipeline.certificate;
+  decided.eps_oc = chosen.eps_oc;
+  // Only estimates that have a pose have oc evidence: a failed registration
+  // keeps oc = 0 (its distances were never computed) and records eps_oc.
+  const auto decide = [&](const PointSet& cloud, PoseEstimate* estimate) {
+    if (estimate->ok()) {
+      estimate->certificate = Certify(object, cloud, estimate->scene_from_model, estimate->keypoints, decided);
+    } else {
+      estimate->certificate.oc.eps_oc = chosen.eps_oc;
+    }
+  };
+  for (std::size_t i = 0; i < result->outcomes.size(); ++i) {
+    CloudOutcome& outcome = result->outcomes[i];
+    if (!outcome.processed()) continue;
+    decide(clouds[i], &outcome.estimate);
+    if (outcome.uncorrected) decide(clouds[i], &outcome.uncorrected.value());
+  }
+  return chosen;
+}
+
+std::string WhereOf(const CloudSource& source) { return source.path.empty() ? source.name : source.path; }
+
+}  // namespace
+
+std::vector<CloudSource> CloudFileSources(const std::vector<std::string>& paths) {
+  std::vector<CloudSource> sources;
+  sources.reserve(paths.size());
+  for (const std::string& path : paths) {
+    CloudSource source;
+    source.name = path;
+    source.path = path;
+    source.load = [path]() { return ReadCloud(path); };
+    sources.push_back(std::move(source));
+  }
+  return sources;
+}
+
+std::vector<CloudSource> DatasetSources(const Dataset& dataset) {
+  std::vector<CloudSource> sources;
+  sources.reserve(dataset.entries.size());
+  for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
+    const DatasetEntry& entry = dataset.entries[i];
+    CloudSource source;
+    source.name = entry.cloud;
+    source.path = dataset.CloudPath(i);
+    source.dataset_index = i;
+    const std::string path = source.path;
+    source.load = [path]() { return ReadCloud(path); };
+    source.given_keypoints = entry.detected_keypoints;
+    source.scene_from_model_truth = entry.pose;
+    sources.push_back(std::move(source));
+  }
+  return sources;
+}
+
+std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
+                                         const std::vector<PointSet>& keypoints) {
+  if (!keypoints.empty() && keypoints.size() != clouds.size()) {
+    throw std::invalid_argument("InMemorySources: keypoints.size() != clouds.size()");
+  }
+  std::vector<CloudSource> sources;
+  sources.reserve(clouds.size());
+  for (std::size_t i = 0; i < clouds.size(); ++i) {
+    CloudSource source;
+    source.name = "#" + std::to_string(i);
+    source.dataset_index = i;
+    const PointSet* cloud = &clouds[i];
+    source.load = [cloud]() { return *cloud; };
+    if (!keypoints.empty()) source.given_keypoints = keypoints[i];
+    sources.push_back(std::move(source));
+  }
+  return sources;
+}
+
+void CertifyBatchOptions::Check() const {
+  pipeline.Check();
+  if (auto_eps_oc) auto_eps_oc_options.Check();
+}
+
+CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<CloudSource>& sources,
+                                const Detector* detector, const CertifyBatchOptions& options,
+                                const ProgressCallback& progress, const CloudVisitor& visit) {
+  options.Check();
+  if (!detector) {
+    for (const CloudSource& source : sources) {
+      if (!source.given_keypoints) {
+        throw InputError(WhereOf(source), "no detector, and no given keypoints (a manifest line's \"detected_keypoints\")");
+      }
+    }
+  }
+  CertifyBatchResult result;
+  result.outcomes.resize(sources.size());
+  result.certificate = options.pipeline.certificate;
+  std::vector<PointSet> clouds(options.auto_eps_oc ? sources.size() : 0);   // kept for auto eps_oc
+  PipelineOptions uncorrected = options.pipeline;
+  uncorrected.correct = false;
+  const int num_keypoints = object.num_keypoints();
+  std::atomic<std::size_t> done{0};
+  ParallelFor(0, static_cast<int>(sources.size()), [&](int i) {
+    ThrowIfInterrupted();
+    const CloudSource& source = sources[i];
+    CloudOutcome& outcome = result.outcomes[i];
+    PointSet cloud;
+    try {
+      cloud = source.load();
+    } catch (const Interrupted&) {
+      throw;
+    } catch (const std::exception& e) {
+      outcome.failure = CloudOutcome::Failure::kLoad;
+      outcome.error = e.what();
+    }
+    if (outcome.processed()) {
+      try {
+        outcome.detected_keypoints = detector ? detector->Detect(cloud) : *source.given_keypoints;
+        if (outcome.detected_keypoints.cols() != num_keypoints) {
+          throw InputError(WhereOf(source), "detected " + std::to_string(outcome.detected_keypoints.cols()) +
+                                                " keypoints, object has " + std::to_string(num_keypoints));
+        }
+      } catch (const Interrupted&) {
+        throw;
+      } catch (const std::exception& e) {
+        outcome.failure = CloudOutcome::Failure::kDetect;
+        outcome.error = e.what();
+      }
+    }
+    if (outcome.processed()) {
+      if (options.also_uncorrected) {
+        outcome.uncorrected = EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected);
+      }
+      outcome.estimate = EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline);
+      if (visit) visit(static_cast<std::size_t>(i), cloud, &outcome);
+      if (options.auto_eps_oc) clouds[i] = std::move(cloud);
+    }
+    if (progress) progress(++done, sources.size());
+  });
+
+  if (options.auto_eps_oc) {
+    result.auto_eps_oc = DecideAutoEpsOc(object, clouds, options, &result);
+    result.certificate.eps_oc = result.auto_eps_oc->eps_oc;
+  }
+  for (const CloudOutcome& outcome : result.outcomes) {
+    if (!outcome.processed()) {
+      ++result.errors;
+      continue;
+    }
+    result.certified += outcome.estimate.certified();
+    result.oc += outcome.estimate.certificate.oc.passed;
+    result.nd += outcome.estimate.certificate.nd.passed;
+  }
+  return result;
+}
+
+}  // namespace c3po

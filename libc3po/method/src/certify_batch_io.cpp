@@ -1,0 +1,70 @@
+// The JSON lines of `c3po certify` (schema in certify_batch.hpp).
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "c3po/method/certify_batch.hpp"
+
+namespace c3po {
+namespace {
+
+nlohmann::json PointsJson(const PointSet& points) {
+  nlohmann::json list = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < points.cols(); ++i) list.push_back({points(0, i), points(1, i), points(2, i)});
+  return list;
+}
+
+nlohmann::ordered_json FiniteOrNull(double value) {
+  return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
+}
+
+}  // namespace
+
+std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& e) {
+  const Pose& T = e.scene_from_model;
+  nlohmann::ordered_json line;  // keys in the documented order, "cloud" first
+  line["cloud"] = cloud;
+  line["R"] = {{T.R(0, 0), T.R(0, 1), T.R(0, 2)}, {T.R(1, 0), T.R(1, 1), T.R(1, 2)}, {T.R(2, 0), T.R(2, 1), T.R(2, 2)}};
+  line["t"] = {T.t(0), T.t(1), T.t(2)};
+  line["keypoints"] = PointsJson(e.keypoints);
+  line["oc"] = e.certificate.oc.passed;
+  line["nd"] = e.certificate.nd.passed;
+  line["certified"] = e.certified();
+  line["oc_distance"] = FiniteOrNull(e.certificate.oc.max_point_distance);
+  line["keypoint_distance"] = e.certificate.oc.max_keypoint_distance;
+  line["nd_set"] = e.certificate.nd.passing_set;
+  line["nd_set_distances"] = e.certificate.nd.set_worst_distance;
+  line["eps_oc"] = e.certificate.oc.eps_oc;
+  line["delta_nd"] = e.certificate.nd.delta_nd;
+  line["iterations"] = e.correction.iterations;
+  line["cost_before"] = FiniteOrNull(e.correction.cost_before);
+  line["cost_after"] = FiniteOrNull(e.correction.cost_after);
+  line["status"] = ToString(e.correction.registration);
+  // Outlier-robust evidence (docs/method.md "Outlier-robust certificates").
+  const ObservableCorrectness& oc = e.certificate.oc;
+  const NonDegeneracy& nd = e.certificate.nd;
+  line["max_outliers"] = oc.max_outliers;
+  line["outliers"] = oc.outlier_count;
+  const std::size_t listed = std::min(oc.outlier_indices.size(), kMaxListedOutliers);
+  line["outlier_indices"] = std::vector<int>(oc.outlier_indices.begin(), oc.outlier_indices.begin() + listed);
+  line["outlier_indices_truncated"] = listed < oc.outlier_indices.size();
+  line["distance_quantiles"] = {FiniteOrNull(oc.quantile50), FiniteOrNull(oc.quantile90),
+                                FiniteOrNull(oc.quantile99), FiniteOrNull(oc.max_point_distance)};
+  line["max_inlier_distance"] = oc.max_inlier_distance;
+  line["keypoint_support"] = nd.keypoint_support;
+  line["nd_set_support"] = nd.set_min_support;
+  line["nd_sets"] = nd.sets_passed;
+  line["nd_local"] = nd.local_checked ? nlohmann::ordered_json(nd.local.passed) : nlohmann::ordered_json(nullptr);
+  line["nd_local_eigenvalue"] = FiniteOrNull(nd.local.min_eigenvalue);
+  line["nd_local_motion"] = {nd.local.motion(0), nd.local.motion(1), nd.local.motion(2),
+                             nd.local.motion(3), nd.local.motion(4), nd.local.motion(5)};
+  line["nd_local_rank"] = nd.local.model_rank;
+  line["ms"] = e.milliseconds;
+  return line.dump();
+}
+
+std::string CertifyErrorJsonLine(const std::string& cloud, const std::string& error) {
+  return nlohmann::json{{"cloud", cloud}, {"error", error}}.dump();
+}
+
+}  // namespace c3po

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# The options certify, eval, selftrain and bench corrector share (cli/options.*)
+# are declared once: the same flags in every --help, help text free of code,
+# repeatable --detector/--model/--plugin taking one value each (so the object
+# may follow them), selftrain accepting --loss, and the same one-line errors
+# for bad threshold, solver and loss values in every command.
+# Usage: shared_options.sh C3PO_BIN SOURCE_DIR WORK_DIR
+set -u
+C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
+rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
+OBJ="$SRC/tests/fixtures/objects/cube.json"
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+pointnet=1; [ "${C3PO_WITH_POINTNET:-ON}" == OFF ] && pointnet=0
+
+commands=("certify" "eval" "bench corrector")
+[ $pointnet -eq 1 ] && commands+=("selftrain")
+for c in "${commands[@]}"; do
+  # shellcheck disable=SC2086
+  "$C3PO" $c --help > "help.txt" 2>&1 || fail "$c --help exited $?"
+  for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue; do
+    grep -q -- "$flag" help.txt || fail "$c --help lacks $flag"
+  done
+  grep -q "allow_extra_args\|->" help.txt && fail "$c --help shows code: $(grep 'allow_extra_args\|->' help.txt)"
+done
+for c in certify eval selftrain; do
+  [ $c == selftrain ] && [ $pointnet -eq 0 ] && continue
+  "$C3PO" $c --help | grep -q -- "--solver" || fail "$c --help lacks --solver"
+done
+"$C3PO" certify --help | grep -q "auto" || fail "certify --eps-oc does not offer auto"
+"$C3PO" eval --help | grep -- "--eps-oc" | grep -q "auto" && fail "eval --eps-oc offers auto, which eval does not do"
+
+"$C3PO" synth "$OBJ" -o data --kind depth --count 4 --points 300 --seed 1 --perturb-sigma 0.1 >/dev/null 2>&1 \
+  || { echo "synth failed"; exit 1; }
+
+# --detector / --plugin take one value: the object may come after them (it was
+# swallowed into the detector list when the option took extra arguments).
+"$C3PO" eval --detector manifest "$OBJ" --data data --no-icp > eval.out 2>&1 \
+  || fail "eval --detector manifest OBJECT: exited $?: $(tail -2 eval.out)"
+grep -q "KeyPo (manifest) + corrector" eval.out || fail "eval table lacks the manifest rows"
+"$C3PO" eval --detector manifest --detector svd "$OBJ" --data data --no-icp > eval2.out 2>&1 \
+  || fail "eval with two --detector and the object last: exited $?: $(tail -2 eval2.out)"
+grep -q "KeyPo (svd) + corrector" eval2.out || fail "eval table lacks the svd rows"
+"$C3PO" certify --detector manifest "$OBJ" --data data --json > certify.out 2>&1; status=$?
+[ $status -le 1 ] || fail "certify --detector manifest OBJECT: exited $status: $(tail -2 certify.out)"
+"$C3PO" certify "$OBJ" --detector svd --detector manifest --data data > two.out 2>&1
+[ $? -eq 2 ] && grep -q "exactly one of --model" two.out || fail "certify with two detectors: $(cat two.out)"
+
+# bad_value NAME CMD...: exit 2 and one stderr line naming the option.
+bad_value() {
+  local option=$1; shift
+  "$@" > bad.out 2> bad.err; local status=$?
+  [ $status -eq 2 ] || fail "$* exited $status, expected 2"
+  [ "$(wc -l < bad.err)" -eq 1 ] && grep -q -- "$option" bad.err || fail "$*: stderr: $(cat bad.err)"
+}
+for c in certify eval; do
+  det=(--detector manifest)
+  bad_value --eps-oc "$C3PO" $c "$OBJ" "${det[@]}" --data data --eps-oc nonsense
+  bad_value --delta-nd "$C3PO" $c "$OBJ" "${det[@]}" --data data --delta-nd 0
+  bad_value --solver "$C3PO" $c "$OBJ" "${det[@]}" --data data --solver slow
+  bad_value --loss "$C3PO" $c "$OBJ" "${det[@]}" --data data --loss median
+  bad_value --max-outliers "$C3PO" $c "$OBJ" "${det[@]}" --data data --max-outliers 3x
+  bad_value --robust-loss "$C3PO" $c "$OBJ" "${det[@]}" --data data --robust-loss huber
+  bad_value --nd-min-eigenvalue "$C3PO" $c "$OBJ" "${det[@]}" --data data --nd-min-eigenvalue -1
+done
+bad_value --max-outliers "$C3PO" bench corrector "$OBJ" --data data --max-outliers -2
+bad_value --eps-oc "$C3PO" eval "$OBJ" --detector manifest --data data --eps-oc auto
+bad_value --loss "$C3PO" bench corrector "$OBJ" --data data --loss median
+if [ $pointnet -eq 1 ]; then
+  "$C3PO" train "$OBJ" --data data -o cube.model --epochs 1 --point-mlp 8 8 --head 8 --points 32 --seed 1 >/dev/null 2>&1 \
+    || fail "train failed"
+  bad_value --loss "$C3PO" selftrain "$OBJ" --model cube.model --data data -o self.model --loss median
+  [ ! -e self.model ] || fail "selftrain wrote a model after a bad --loss"
+  bad_value --robust-loss "$C3PO" selftrain "$OBJ" --model cube.model --data data -o self.model --robust-loss huber
+  [ ! -e self.model ] || fail "selftrain wrote a model after a bad --robust-loss"
+fi
+
+echo "failures: $failures"
+[ $failures -eq 0 ]
