@@ -1,5 +1,6 @@
 // c3po synth: simulated (sim) or rendered depth (depth) clouds with ground
-// truth, written as a dataset folder (manifest.jsonl + binary PLY clouds).
+// truth, written as a dataset folder (manifest.jsonl + binary PLY clouds), or
+// with --format bop rendered scenes in the BOP layout (cli/synth_bop.cpp).
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -13,11 +14,13 @@
 #include "c3po/synth/synth.hpp"
 #include "command.hpp"
 #include "progress_bar.hpp"
+#include "synth_bop.hpp"
 
 namespace c3po::cli {
 namespace {
 
 struct SynthCommand {
+  std::string format = "manifest";
   std::string object;
   std::string output;
   std::string kind;
@@ -32,6 +35,7 @@ struct SynthCommand {
   std::string perturb_sigma;
   std::string perturb_fraction;
   std::uint64_t seed = 0;
+  SynthBopCommand bop;
 };
 
 void Declare(CLI::App& command, SynthCommand& o) {
@@ -39,10 +43,12 @@ void Declare(CLI::App& command, SynthCommand& o) {
       ->required();
   command.add_option("-o,--output", o.output, "Dataset folder to write (replaced when complete)")
       ->required();
+  command.add_option("--format", o.format, "manifest (manifest.jsonl + PLY clouds) or bop (a BOP "
+                                           "split folder: depth PNGs, masks, scene_gt.json, ...)")
+      ->capture_default_str();
   command.add_option("--kind", o.kind, "sim: uniform samples of the whole surface; depth: what a "
-                                       "pinhole depth camera sees")
-      ->required();
-  command.add_option("--count", o.count, "Number of clouds")->required();
+                                       "pinhole depth camera sees (required for --format manifest)");
+  command.add_option("--count", o.count, "Number of clouds (bop: images)")->required();
   command.add_option("--points", o.points, "Points per cloud (depth: fewer if fewer pixels)")
       ->capture_default_str();
   command.add_option("--pose", o.pose, "easy (<= 0.8 rad from a reference view), hard (any "
@@ -54,17 +60,39 @@ void Declare(CLI::App& command, SynthCommand& o) {
   command.add_option("--dropout", o.dropout, "Drop each point with this probability, in [0, 1)")
       ->capture_default_str();
   command.add_option("--min-points", o.min_points,
-                     "depth: redraw views with fewer points (default points/2)");
+                     "depth: redraw views with fewer points (default points/2); bop: with fewer "
+                     "visible target pixels (default 200)");
   command.add_option("--distance", o.distance,
                      "A,B: depth of the object centre in metres (default [0.5, 1.5] x the "
                      "distance where d spans 40 % of the image height)");
   command.add_option("--intrinsics", o.intrinsics,
-                     "fx,fy,cx,cy,width,height (default 525,525,319.5,239.5,640,480)");
+                     "fx,fy,cx,cy,width,height (default 525,525,319.5,239.5,640,480; bop: YCB-V's "
+                     "1066.778,1067.487,312.9869,241.3109,640,480)");
   command.add_option("--perturb-sigma", o.perturb_sigma,
                      "Write detected_keypoints: keypoints moved by U[-S d/2, S d/2] per coordinate");
   command.add_option("--perturb-fraction", o.perturb_fraction,
                      "Probability that a keypoint is perturbed (default 0.8)");
   command.add_option("--seed", o.seed, "Seed (same seed, same bytes)")->capture_default_str();
+  DeclareBopOptions(command, o.bop);
+}
+
+// Options given on the command line that the chosen format does not use.
+void CheckFormatOptions(const CLI::App& command, const SynthCommand& o) {
+  if (o.format == "bop") {
+    for (const char* name : {"--kind", "--points", "--noise", "--dropout", "--perturb-sigma",
+                             "--perturb-fraction"}) {
+      if (command.count(name) > 0) {
+        throw InputError(name, "not used by --format bop (see --artefacts and docs/synth_bop.md)");
+      }
+    }
+  } else if (o.format == "manifest") {
+    for (const std::string& name : BopOnlyOptions()) {
+      if (command.count(name) > 0) throw InputError(name, "only used with --format bop");
+    }
+    if (o.kind.empty()) throw InputError("--kind", "required (sim or depth) for --format manifest");
+  } else {
+    throw InputError("--format", "'" + o.format + "': expected manifest or bop");
+  }
 }
 
 // A non-negative distance: "0", "0.001", "1mm", "0.5%d".
@@ -114,7 +142,21 @@ SynthOptions MakeOptions(const SynthCommand& o, double diameter) {
   return options;
 }
 
-int Run(const SynthCommand& o) {
+int Run(const CLI::App& command, const SynthCommand& o) {
+  CheckFormatOptions(command, o);
+  if (o.format == "bop") {
+    SynthCommonForBop common;
+    common.object = o.object;
+    common.output = o.output;
+    common.count = o.count;
+    common.pose = o.pose;
+    common.min_points = o.min_points;
+    common.distance = o.distance;
+    common.intrinsics = o.intrinsics;
+    common.seed = o.seed;
+    if (o.min_points < -1) throw InputError("--min-points", "must be >= 0");
+    return RunSynthBop(common, o.bop);
+  }
   const ObjectModel object = LoadObject(o.object);
   const SynthOptions options = MakeOptions(o, object.diameter());
   ProgressBar progress(std::string("synth ") + ToString(options.kind),
@@ -162,7 +204,7 @@ int Run(const SynthCommand& o) {
 RunFunction SetupSynth(CLI::App& command) {
   auto options = std::make_shared<SynthCommand>();
   Declare(command, *options);
-  return [options]() { return Run(*options); };
+  return [options, app = &command]() { return Run(*app, *options); };
 }
 
 }  // namespace c3po::cli

@@ -118,5 +118,33 @@ state=$(dataset_state sim); echo "  sim: $state"
 [ "$state" = "complete ${SIM[1]}" ] || fail "synth_over: the existing dataset is now: $state"
 [ "$(cd sim && sha256sum -- * | sha256sum)" = "$before" ] || fail "synth_over: the existing dataset changed"
 
+# --- synth --format bop ---------------------------------------------------------
+# Signalled once the hidden folder holds 20 depth images of 4000 asked for:
+# nothing is left for a new folder, and an earlier BOP output stays intact.
+interrupt_synth_bop() {
+  local name=$1 signal=$2 dir=$3 waited=0
+  "$C3PO" synth "$OBJ" -o "$dir" --format bop --count 4000 --artefacts realistic --depth-scale 1 \
+    --intrinsics 400,400,159.5,119.5,320,240 --seed 5 > "$name.out" 2> "$name.err" &
+  local pid=$!
+  until [ "$(find . -maxdepth 4 -path "./.$dir.partial.*/*/depth/*.png" 2>/dev/null | wc -l)" -ge 20 ]; do
+    sleep 0.05; waited=$((waited + 1))
+    if ! kill -0 $pid 2>/dev/null || [ $waited -gt 2000 ]; then break; fi
+  done
+  kill -s "$signal" $pid 2>/dev/null || echo "($name finished before the signal)"
+  wait $pid; local status=$?
+  echo "$name: killed with SIG$signal; status $status; stderr tail: $(tail -1 "$name.err")"
+  [ $status -eq 130 ] && grep -q interrupted "$name.err" \
+    || fail "$name: status $status, not c3po's interrupt status 130 with its message"
+  if ls -A | grep -E "^\.$dir|\.partial|\.tmp"; then fail "$name: temporary files left next to $dir"; fi
+}
+interrupt_synth_bop synth_bop_new INT bop_fresh
+[ ! -e bop_fresh ] || fail "synth_bop_new: an interrupted synth --format bop left bop_fresh"
+"$C3PO" synth "$OBJ" -o bop_old --format bop --count 3 --depth-scale 1 --intrinsics 400,400,159.5,119.5,320,240 \
+  > /dev/null 2>&1 || fail "synth --format bop reference run"
+before=$(cd bop_old && find . -type f | sort | xargs sha256sum | sha256sum)
+interrupt_synth_bop synth_bop_over TERM bop_old
+[ "$(cd bop_old && find . -type f | sort | xargs sha256sum | sha256sum)" = "$before" ] \
+  || fail "synth_bop_over: the earlier BOP output changed"
+
 echo "failures: $failures"
 [ $failures -eq 0 ]

@@ -2,12 +2,14 @@
 #include "c3po/base/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <streambuf>
 #include <vector>
 
@@ -161,6 +163,118 @@ std::string ReadFileToString(const std::string& path) {
   }
   ::close(fd);
   return contents;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string StripTrailingSlashes(std::string path) {
+  while (path.size() > 1 && path.back() == '/') path.pop_back();
+  return path;
+}
+
+// Flushes every file of the folder's file system to disk (one syncfs instead
+// of an fsync per file) and records the folder entries.
+void SyncFileSystemOf(const std::string& folder) {
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::syncfs(fd);
+  ::fsync(fd);
+  ::close(fd);
+}
+
+// Removes ".<name>.partial.<pid>" siblings left by writers that were killed
+// (their process no longer exists); live writers' folders are kept.
+void RemoveStalePartials(const std::string& parent, const std::string& name) {
+  const std::string prefix = "." + name + ".partial.";
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string leaf = it->path().filename().string();
+    if (leaf.rfind(prefix, 0) != 0) continue;
+    const std::string pid_text = leaf.substr(prefix.size());
+    if (pid_text.empty() || pid_text.find_first_not_of("0123456789") != std::string::npos || pid_text.size() > 9) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(pid_text));
+    if (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH) {
+      std::error_code ignored;
+      fs::remove_all(it->path(), ignored);
+    }
+  }
+}
+
+[[noreturn]] void FailWrite(const std::string& path, const std::error_code& ec) {
+  throw InputError(path, "cannot write: " + ec.message());
+}
+
+}  // namespace
+
+StagedFolder::StagedFolder(std::string dir, std::string marker, std::string kind)
+    : dir_(StripTrailingSlashes(std::move(dir))), marker_(std::move(marker)), kind_(std::move(kind)) {
+  const std::string name = fs::path(dir_).filename().string();
+  if (dir_.empty() || name.empty() || name == "." || name == "..") {
+    throw InputError(dir_, "cannot write: not a usable folder name");
+  }
+  CheckReplaceable();
+  const fs::path parent_path = fs::path(dir_).parent_path();
+  const std::string parent = parent_path.empty() ? "." : parent_path.string();
+  std::error_code ec;
+  fs::create_directories(parent, ec);
+  if (ec) FailWrite(dir_, ec);
+  RemoveStalePartials(parent, name);
+  tmp_dir_ = parent + "/." + name + ".partial." + std::to_string(::getpid());
+  fs::remove_all(tmp_dir_, ec);
+  if (!fs::create_directory(tmp_dir_, ec) || ec) {
+    FailWrite(dir_, ec ? ec : std::make_error_code(std::errc::file_exists));
+  }
+}
+
+StagedFolder::~StagedFolder() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove_all(tmp_dir_, ec);
+}
+
+bool StagedFolder::HasMarker() const {
+  std::error_code ec;
+  return fs::is_regular_file(fs::path(dir_) / marker_, ec);
+}
+
+void StagedFolder::CheckReplaceable() const {
+  std::error_code ec;
+  const fs::file_status status = fs::status(dir_, ec);
+  if (!fs::exists(status)) return;
+  if (fs::is_directory(status) && (HasMarker() || fs::is_empty(dir_, ec))) return;
+  throw InputError(dir_, "exists and is not a " + kind_ + " (no " + marker_ +
+                             "); refusing to overwrite it");
+}
+
+void StagedFolder::Commit() {
+  if (committed_) throw std::logic_error("StagedFolder::Commit called twice");
+  SyncFileSystemOf(tmp_dir_);
+  CheckReplaceable();
+  const fs::path parent_path = fs::path(dir_).parent_path();
+  const std::string parent = parent_path.empty() ? "." : parent_path.string();
+  std::error_code ec;
+  if (HasMarker()) {
+    // Swap: old folder away, new one in, old one deleted.
+    const std::string old_dir =
+        parent + "/." + fs::path(dir_).filename().string() + ".old." + std::to_string(::getpid());
+    fs::remove_all(old_dir, ec);
+    fs::rename(dir_, old_dir, ec);
+    if (ec) FailWrite(dir_, ec);
+    fs::rename(tmp_dir_, dir_, ec);
+    if (ec) {
+      std::error_code restore;
+      fs::rename(old_dir, dir_, restore);
+      FailWrite(dir_, ec);
+    }
+    fs::remove_all(old_dir, ec);
+  } else {
+    fs::rename(tmp_dir_, dir_, ec);   // also replaces an empty folder
+    if (ec) FailWrite(dir_, ec);
+  }
+  SyncFileSystemOf(parent);   // make the renames durable
+  committed_ = true;
 }
 
 }  // namespace c3po

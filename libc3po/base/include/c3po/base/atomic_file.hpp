@@ -18,6 +18,39 @@ void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write, bool sync = true);
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
+// A folder published atomically: files are written into a hidden sibling
+// ".<name>.partial.<pid>" (path()), and Commit() syncs it once and renames it
+// to `dir`. An existing `dir` is replaced only when it is empty or holds the
+// `marker` file (a folder this kind of writer made); anything else is refused
+// with InputError("dir: exists and is not a <kind> (no <marker>); refusing to
+// overwrite it"), checked by the constructor too so a long run fails before
+// it starts. Destroying an uncommitted StagedFolder removes the partial
+// folder, so an interrupted run leaves nothing; partial folders of killed
+// processes are removed by the next writer of the same `dir`.
+class StagedFolder {
+ public:
+  StagedFolder(std::string dir, std::string marker, std::string kind);
+  ~StagedFolder();
+  StagedFolder(const StagedFolder&) = delete;
+  StagedFolder& operator=(const StagedFolder&) = delete;
+
+  const std::string& dir() const { return dir_; }
+  const std::string& path() const { return tmp_dir_; }   // where to write
+  // Files written without fsync are made durable here (one syncfs).
+  void Commit();
+  bool committed() const { return committed_; }
+
+ private:
+  void CheckReplaceable() const;
+  bool HasMarker() const;
+
+  std::string dir_;
+  std::string marker_;
+  std::string kind_;
+  std::string tmp_dir_;
+  bool committed_ = false;
+};
+
 // Reads a whole file; throws InputError("path: cannot read: reason").
 std::string ReadFileToString(const std::string& path);
 

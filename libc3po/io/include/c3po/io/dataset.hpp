@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "c3po/base/atomic_file.hpp"
 #include "c3po/base/types.hpp"
 
 namespace c3po {
@@ -62,11 +63,10 @@ class DatasetWriter {
   // existing file or folder is refused with InputError (also checked by the
   // constructor, so a long run fails before it starts).
   void Commit();
-  const std::string& temporary_dir() const { return tmp_dir_; }
+  const std::string& temporary_dir() const { return folder_.path(); }
 
  private:
-  std::string dir_;
-  std::string tmp_dir_;
+  StagedFolder folder_;
   std::mutex mutex_;   // guards lines_, clouds_, committed_
   std::vector<std::pair<std::size_t, std::string>> lines_;
   std::set<std::string> clouds_;
