@@ -317,7 +317,7 @@ TEST_CASE("--eps-oc auto with a budget m: the m farthest points never set eps_oc
   CHECK(result.certified == again.certified);
   CHECK(result.nd == again.nd);
   CHECK(certified == result.certified);
-  CHECK(result.certified > 0);   // the budget absorbs the stray points
+  CHECK(result.oc > 0);   // the budget absorbs the stray points (nd_m may still refuse: > m supports)
 }
 
 TEST_CASE("CertifyBatch stops when an interrupt is requested") {
