@@ -32,6 +32,9 @@ struct CorrectorBenchCommand {
   int max_clouds = 0;
   std::string json_path;
   std::string cases_path;
+  std::string stray = "0";
+  std::string correct = "0.02";
+  RobustFlags robust;
 };
 
 
@@ -88,6 +91,13 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
   for (std::string name; std::getline(solver_list, name, ',');) options.solvers.push_back(ParseCorrectorSolver(name));
   options.corrector.loss = ParsePointCloudLoss(cmd.corrector.loss);
   options.certificate = ResolveThresholds(cmd.thresholds, object);
+  ResolveRobust(cmd.robust, &options.certificate, &options.corrector);
+  {
+    const OutlierBudget stray = ParseOutlierBudget(cmd.stray);   // the same "P%" syntax
+    if (stray.count > 0) throw InputError("--stray", "give a percentage of each cloud's points (5%)");
+    options.stray_fraction = stray.fraction;
+  }
+  options.correct_hausdorff = ParseThreshold(cmd.correct, object.diameter(), "--correct");
   options.seed = cmd.seed;
   options.threads = cmd.threads;
   options.max_clouds = cmd.max_clouds;
@@ -103,20 +113,27 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
   }, cmd.cases_path.empty() ? nullptr : &cases);
   progress.Finish();
   std::printf("corrector analysis: %s, %d clouds, %.0f%% of keypoints perturbed by U[-sigma d/2, sigma d/2], "
-              "d = %.4g, eps_oc = %.4g, loss = %s, %d thread(s)\n",
+              "d = %.4g, eps_oc = %.4g, loss = %s, %s, %d thread(s)\n",
               object.name().c_str(), rows.empty() ? 0 : rows[0].clouds, 100 * options.fraction,
-              object.diameter(), options.certificate.eps_oc, ToString(options.corrector.loss), options.threads);
+              object.diameter(), options.certificate.eps_oc, ToString(options.corrector.loss),
+              DescribeRobust(options.certificate, options.corrector).c_str(), options.threads);
   std::printf("times per cloud, medians in ms: corr = correction alone (registration: T(y~) only), "
               "corr cpu = its thread CPU time, cert = certificates, total = corr + cert\n");
-  std::printf("%6s  %-18s %9s %9s %9s %9s %9s %7s %8s %8s %8s %8s %7s\n", "sigma", "method", "rot med", "rot mean",
-              "t/d med", "t/d mean", "ADD-S/d", "% oc", "corr", "corr cpu", "cert", "total", "iters");
+  std::printf("certificates: %.1f%% stray points per cloud; correct = Hausdorff(T*·B̂, T̂·B̂) <= %.4g; "
+              "%%cert = certified (oc_m and nd_m), %%c.cert = certified among the correct, false = certified and "
+              "not correct, nd q05 = 5%% quantile of the local nd eigenvalue over correct poses\n",
+              100.0 * options.stray_fraction, options.correct_hausdorff);
+  std::printf("%6s  %-18s %9s %9s %9s %9s %9s %7s %8s %8s %8s %8s %7s %7s %7s %7s %6s %8s\n", "sigma", "method", "rot med", "rot mean",
+              "t/d med", "t/d mean", "ADD-S/d", "% oc", "corr", "corr cpu", "cert", "total", "iters",
+              "%corr", "%cert", "%c.cert", "false", "nd q05");
   nlohmann::json json = nlohmann::json::array();
   for (const auto& row : rows) {
-    std::printf("%6.2f  %-18s %8.2f° %8.2f° %9.4f %9.4f %9.4f %7.1f %8.3f %8.3f %8.3f %8.3f %7.1f\n", row.sigma,
+    std::printf("%6.2f  %-18s %8.2f° %8.2f° %9.4f %9.4f %9.4f %7.1f %8.3f %8.3f %8.3f %8.3f %7.1f %7.1f %7.1f %7.1f %6d %8.4f\n", row.sigma,
                 row.method.c_str(), row.median_rotation_deg, row.mean_rotation_deg,
                 row.median_translation_over_d, row.mean_translation_over_d, row.median_adds_over_d,
                 row.percent_oc, row.median_corrector_ms, row.median_corrector_cpu_ms, row.median_certify_ms,
-                row.median_ms, row.mean_iterations);
+                row.median_ms, row.mean_iterations, row.percent_correct, row.percent_certified,
+                row.percent_correct_certified, row.false_certificates, row.q05_nd_eigenvalue_correct);
     json.push_back({{"sigma", row.sigma}, {"method", row.method}, {"clouds", row.clouds},
                     {"median_rotation_deg", row.median_rotation_deg}, {"mean_rotation_deg", row.mean_rotation_deg},
                     {"median_translation_over_d", row.median_translation_over_d},
@@ -126,7 +143,14 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
                     {"median_corrector_ms", row.median_corrector_ms}, {"mean_corrector_ms", row.mean_corrector_ms},
                     {"median_corrector_cpu_ms", row.median_corrector_cpu_ms},
                     {"median_certify_ms", row.median_certify_ms},
-                    {"mean_iterations", row.mean_iterations}});
+                    {"mean_iterations", row.mean_iterations},
+                    {"percent_correct", row.percent_correct}, {"percent_certified", row.percent_certified},
+                    {"percent_correct_certified", row.percent_correct_certified},
+                    {"false_certificates", row.false_certificates},
+                    {"max_certified_hausdorff", row.max_certified_hausdorff},
+                    {"median_hausdorff", row.median_hausdorff},
+                    {"q05_nd_eigenvalue_correct", row.q05_nd_eigenvalue_correct},
+                    {"percent_nd_local", row.percent_nd_local}});
   }
   if (!cmd.json_path.empty()) WriteFileAtomically(cmd.json_path, json.dump(2) + "\n");
   if (!cmd.cases_path.empty()) WriteFileAtomically(cmd.cases_path, CasesJsonLines(object, dataset, options, cases));
@@ -144,6 +168,11 @@ void SetupCorrectorBench(CLI::App& parent, std::function<int()>* run) {
   AddLossOption(*sub, &cmd->corrector.loss);
   AddThresholdOptions(*sub, &cmd->thresholds, AutoEpsOc::kRefused);
   AddSeedOption(*sub, &cmd->seed, "of the perturbations");
+  AddRobustOptions(*sub, &cmd->robust);
+  sub->add_option("--stray", cmd->stray, "Add stray points to every cloud: a percentage of its points (5%; "
+                                         "half background, half flying pixels; seeded by --seed)");
+  sub->add_option("--correct", cmd->correct, "A pose is correct when Hausdorff(T*·B̂, T̂·B̂) is at most this "
+                                             "(distance or fraction of d; default 0.02)");
   AddThreadsOption(*sub, &cmd->threads, "1 gives honest per-cloud times");
   sub->add_option("--max-clouds", cmd->max_clouds, "Use at most this many clouds (0 = all)");
   sub->add_option("--json", cmd->json_path, "Also write the rows as JSON to this file");

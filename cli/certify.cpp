@@ -29,6 +29,7 @@ struct CertifyCommand {
   std::string output_path;
   ThresholdFlags thresholds;
   CorrectorFlags corrector;
+  RobustFlags robust;
   bool no_correct = false;
 };
 
@@ -43,10 +44,12 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
   }
   const Eigen::AngleAxisd rotation(e.scene_from_model.R);
   std::snprintf(text, sizeof text,
-                "%s  %s  oc=%d (%.4g)  nd=%d (set %d)  t=[%.4f %.4f %.4f]  angle=%.1f deg  %d it  %.1f ms",
+                "%s  %s  oc=%d (%.4g; %d/%d outliers)  nd=%d (set %d, local %.3g)  t=[%.4f %.4f %.4f]  "
+                "angle=%.1f deg  %d it  %.1f ms",
                 cloud.c_str(), e.certified() ? "CERTIFIED" : "not certified", e.certificate.oc.passed,
-                e.certificate.oc.max_point_distance, e.certificate.nd.passed,
-                e.certificate.nd.passing_set, e.scene_from_model.t(0), e.scene_from_model.t(1),
+                e.certificate.oc.max_point_distance, e.certificate.oc.outlier_count,
+                e.certificate.oc.max_outliers, e.certificate.nd.passed, e.certificate.nd.passing_set,
+                e.certificate.nd.local.min_eigenvalue, e.scene_from_model.t(0), e.scene_from_model.t(1),
                 e.scene_from_model.t(2), rotation.angle() * 180.0 / M_PI, e.correction.iterations,
                 e.milliseconds);
   return text;
@@ -61,6 +64,7 @@ int Run(const CertifyCommand& cmd) {
   options.pipeline.correct = !cmd.no_correct;
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
+  ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
   options.auto_eps_oc = cmd.thresholds.auto_eps_oc();
 
   std::vector<CloudSource> sources = CloudFileSources(cmd.clouds);
@@ -103,9 +107,11 @@ int Run(const CertifyCommand& cmd) {
     std::cout << json_lines.str();
   }
   if (!cmd.json) {
-    std::printf("certified %d/%zu (oc %d, nd %d, errors %d); eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g)\n",
+    std::printf("certified %d/%zu (oc %d, nd %d, errors %d); eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g); "
+                "%s\n",
                 result.certified, sources.size(), result.oc, result.nd, result.errors, result.certificate.eps_oc,
-                result.certificate.delta_nd, object.diameter());
+                result.certificate.delta_nd, object.diameter(),
+                DescribeRobust(result.certificate, options.pipeline.corrector).c_str());
   }
   if (result.errors > 0) return 2;
   return result.certified == static_cast<int>(sources.size()) ? 0 : 1;
@@ -124,6 +130,7 @@ RunFunction SetupCertify(CLI::App& command) {
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kAllowed);
   command.add_flag("--no-correct", cmd->no_correct, "Certify the plain registration of the detected keypoints");
   AddCorrectorOptions(command, &cmd->corrector);
+  AddRobustOptions(command, &cmd->robust);
   return [cmd]() { return Run(*cmd); };
 }
 

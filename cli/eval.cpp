@@ -32,6 +32,7 @@ struct EvalCommand {
   std::string adds_variant = "symmetric";
   ThresholdFlags thresholds;
   CorrectorFlags corrector;
+  RobustFlags robust;
   bool no_icp = false;
   int icp_iterations = 30;
   std::string icp_max_distance;
@@ -97,6 +98,7 @@ EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object)
     throw InputError(cmd.object_path, "the object has no eps_oc / delta_nd: give --eps-oc and --delta-nd");
   }
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
+  ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
   options.run_icp = !cmd.no_icp;
   options.icp.max_iterations = cmd.icp_iterations;
   options.icp.trim_fraction = cmd.icp_trim;
@@ -155,6 +157,7 @@ std::string CommandLine(const EvalCommand& cmd) {
   line += " --adds " + cmd.adds_variant + " --adds-threshold " + cmd.adds_threshold + " --auc-max " + cmd.auc_max;
   if (!cmd.thresholds.eps_oc.empty()) line += " --eps-oc " + cmd.thresholds.eps_oc;
   if (!cmd.thresholds.delta_nd.empty()) line += " --delta-nd " + cmd.thresholds.delta_nd;
+  line += RobustCommandLine(cmd.robust);
   if (cmd.no_icp) line += " --no-icp";
   return line;
 }
@@ -215,6 +218,7 @@ RunFunction SetupEval(CLI::App& command) {
   command.add_option("--auc-max", cmd->auc_max, "Upper end of the ADD-S AUC curve (default 10%d)");
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kRefused);
   AddCorrectorOptions(command, &cmd->corrector);
+  AddRobustOptions(command, &cmd->robust);
   command.add_flag("--no-icp", cmd->no_icp, "Skip the KeyPo + ICP rows");
   command.add_option("--icp-iterations", cmd->icp_iterations, "ICP iterations (default 30)");
   command.add_option("--icp-max-distance", cmd->icp_max_distance, "ICP correspondence gate (default: none)");

@@ -1,6 +1,9 @@
 // Shared command-line options (options.hpp).
 #include "options.hpp"
 
+#include <cstdio>
+#include <cstdlib>
+
 #include "c3po/base/error.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/registry.hpp"
@@ -42,6 +45,53 @@ void AddLossOption(CLI::App& command, std::string* loss) {
 void ResolveCorrector(const CorrectorFlags& flags, CorrectorOptions* options) {
   options->solver = ParseCorrectorSolver(flags.solver);
   options->loss = ParsePointCloudLoss(flags.loss);
+}
+
+void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
+  command.add_option("--max-outliers", flags->max_outliers,
+                     "Outlier budget m of the certificates: a count (10) or a percentage of each cloud's points "
+                     "(2%); default 0 = the paper");
+  command.add_option("--robust-loss", flags->robust_loss,
+                     "Robust kernel of the corrector's point-cloud term, truncated at eps_oc: none (default), "
+                     "tls (truncated least squares, GNC) or gm (Geman-McClure)");
+  command.add_option("--nd-min-eigenvalue", flags->nd_min_eigenvalue,
+                     "Local non-degeneracy threshold on the smallest generalised eigenvalue (data vs model "
+                     "point-to-plane information); 0 = local test off");
+}
+
+void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, CorrectorOptions* corrector) {
+  if (!flags.max_outliers.empty()) certificate->max_outliers = ParseOutlierBudget(flags.max_outliers);
+  corrector->robust_loss = ParseRobustLoss(flags.robust_loss);
+  if (!flags.nd_min_eigenvalue.empty()) {
+    char* end = nullptr;
+    const double value = std::strtod(flags.nd_min_eigenvalue.c_str(), &end);
+    if (*end != '\0' || !(value >= 0) || !(value < 1e6)) {
+      throw InputError("--nd-min-eigenvalue", "'" + flags.nd_min_eigenvalue + "' must be a number >= 0");
+    }
+    certificate->local_nondegeneracy = value > 0;
+    if (value > 0) certificate->local.min_eigenvalue = value;
+  }
+}
+
+std::string DescribeRobust(const CertificateOptions& certificate, const CorrectorOptions& corrector) {
+  char text[160];
+  if (certificate.local_nondegeneracy) {
+    std::snprintf(text, sizeof text, "m = %s, robust loss = %s, local nd >= %g",
+                  certificate.max_outliers.ToString().c_str(), ToString(corrector.robust_loss),
+                  certificate.local.min_eigenvalue);
+  } else {
+    std::snprintf(text, sizeof text, "m = %s, robust loss = %s, local nd off",
+                  certificate.max_outliers.ToString().c_str(), ToString(corrector.robust_loss));
+  }
+  return text;
+}
+
+std::string RobustCommandLine(const RobustFlags& flags) {
+  std::string line;
+  if (!flags.max_outliers.empty()) line += " --max-outliers " + flags.max_outliers;
+  if (flags.robust_loss != "none") line += " --robust-loss " + flags.robust_loss;
+  if (!flags.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + flags.nd_min_eigenvalue;
+  return line;
 }
 
 void AddDetectorOptions(CLI::App& command, DetectorFlags* flags, DetectorCount count) {

@@ -45,6 +45,24 @@ void AddLossOption(CLI::App& command, std::string* loss);
 // `options` with solver and loss set from the flags (InputError on bad names).
 void ResolveCorrector(const CorrectorFlags& flags, CorrectorOptions* options);
 
+// --max-outliers, --robust-loss, --nd-min-eigenvalue (issue 16): the outlier
+// budget m of oc_m / nd_m, the corrector's robust kernel, the local
+// non-degeneracy threshold. The meaning lives in the library (certificate.hpp,
+// corrector.hpp, local_nondegeneracy.hpp).
+struct RobustFlags {
+  std::string max_outliers;        // "" = the source's default (0 for ready-made clouds)
+  std::string robust_loss = "none";
+  std::string nd_min_eigenvalue;   // "" = default; 0 = local test off
+};
+void AddRobustOptions(CLI::App& command, RobustFlags* flags);
+// Fills the certificate's budget and local test and the corrector's kernel
+// (InputError naming the option on a bad value).
+void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, CorrectorOptions* corrector);
+// "m = 2%, robust loss = tls, local nd >= 0.02" for the printed summary.
+std::string DescribeRobust(const CertificateOptions& certificate, const CorrectorOptions& corrector);
+// " --max-outliers 2% --robust-loss tls" (the flags given, for a command line).
+std::string RobustCommandLine(const RobustFlags& flags);
+
 // --model, --detector, --plugin: one detector (certify) or several (eval).
 struct DetectorFlags {
   std::vector<std::string> models;

@@ -30,6 +30,7 @@ struct SelftrainCommand {
   std::string optimizer = "adam";
   ThresholdFlags thresholds;
   CorrectorFlags corrector;
+  RobustFlags robust;
   bool resume = false;
 };
 
@@ -57,6 +58,7 @@ int Run(SelftrainCommand cmd) {
   SelfTrainOptions& options = cmd.options;
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
+  ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
   options.checkpoint_path = cmd.output_path + ".ckpt";
   try {
     options.Check();
@@ -85,9 +87,11 @@ int Run(SelftrainCommand cmd) {
   EpochLogFile log(cmd.output_path);
   if (cmd.resume) log.LoadExisting();
   std::fprintf(stderr, "self-training on %zu unlabelled clouds of %s: eps_oc = %.6g, delta_nd = %.6g (d = %.6g), "
-               "%d epochs, batch %d, %s lr %g\n",
+               "%s, %d epochs, batch %d, %s lr %g\n",
                clouds.size(), object.name().c_str(), options.pipeline.certificate.eps_oc,
-               options.pipeline.certificate.delta_nd, object.diameter(), options.epochs, options.batch,
+               options.pipeline.certificate.delta_nd, object.diameter(),
+               DescribeRobust(options.pipeline.certificate, options.pipeline.corrector).c_str(), options.epochs,
+               options.batch,
                cmd.optimizer.c_str(), cmd.lr);
   ProgressBar progress("selftrain", 1);
   const SelfTrainResult result = SelfTrain(
@@ -138,6 +142,7 @@ RunFunction SetupSelftrain(CLI::App& command) {
   command.add_option("--stop-at", o.stop_at_percent_oc, "Stop when this % of the held-out clouds is observably correct");
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kAllowed);
   AddCorrectorOptions(command, &cmd->corrector);
+  AddRobustOptions(command, &cmd->robust);
   AddSeedOption(command, &o.seed, "split, shuffling");
   command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt");
   return [cmd]() { return Run(*cmd); };

@@ -18,7 +18,7 @@ commands=("certify" "eval" "bench corrector")
 for c in "${commands[@]}"; do
   # shellcheck disable=SC2086
   "$C3PO" $c --help > "help.txt" 2>&1 || fail "$c --help exited $?"
-  for flag in --eps-oc --delta-nd --loss; do
+  for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue; do
     grep -q -- "$flag" help.txt || fail "$c --help lacks $flag"
   done
   grep -q "allow_extra_args\|->" help.txt && fail "$c --help shows code: $(grep 'allow_extra_args\|->' help.txt)"
@@ -59,7 +59,11 @@ for c in certify eval; do
   bad_value --delta-nd "$C3PO" $c "$OBJ" "${det[@]}" --data data --delta-nd 0
   bad_value --solver "$C3PO" $c "$OBJ" "${det[@]}" --data data --solver slow
   bad_value --loss "$C3PO" $c "$OBJ" "${det[@]}" --data data --loss median
+  bad_value --max-outliers "$C3PO" $c "$OBJ" "${det[@]}" --data data --max-outliers 3x
+  bad_value --robust-loss "$C3PO" $c "$OBJ" "${det[@]}" --data data --robust-loss huber
+  bad_value --nd-min-eigenvalue "$C3PO" $c "$OBJ" "${det[@]}" --data data --nd-min-eigenvalue -1
 done
+bad_value --max-outliers "$C3PO" bench corrector "$OBJ" --data data --max-outliers -2
 bad_value --eps-oc "$C3PO" eval "$OBJ" --detector manifest --data data --eps-oc auto
 bad_value --loss "$C3PO" bench corrector "$OBJ" --data data --loss median
 if [ $pointnet -eq 1 ]; then
@@ -67,6 +71,8 @@ if [ $pointnet -eq 1 ]; then
     || fail "train failed"
   bad_value --loss "$C3PO" selftrain "$OBJ" --model cube.model --data data -o self.model --loss median
   [ ! -e self.model ] || fail "selftrain wrote a model after a bad --loss"
+  bad_value --robust-loss "$C3PO" selftrain "$OBJ" --model cube.model --data data -o self.model --robust-loss huber
+  [ ! -e self.model ] || fail "selftrain wrote a model after a bad --robust-loss"
 fi
 
 echo "failures: $failures"

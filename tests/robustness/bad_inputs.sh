@@ -62,6 +62,14 @@ cp "$FIX/clouds/bad_inf.pcd" inf.pcd
 check inf_cloud "2" - inf.pcd inf.pcd -- "$C3PO" certify "$CUBE" --detector svd inf.pcd
 printf '0.5 0.5 0.5\n' > one_point.xyz
 check one_point_cloud "1 2" - one_point.xyz one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd one_point.xyz
+check one_point_budget "1 2" - one_point.xyz one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --max-outliers 1 one_point.xyz
+# Outlier-robust options (issue 16): one line naming the option, exit 2.
+for bad in -1 abc 100% 2.5 %; do
+  check "max_outliers_${bad//%/pct}" "2" - --max-outliers one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --max-outliers "$bad" one_point.xyz
+done
+check robust_loss_bad "2" - --robust-loss one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --robust-loss huber one_point.xyz
+check robust_loss_max "2" - "robust kernel" one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --robust-loss tls --loss max one_point.xyz
+check nd_eigenvalue_bad "2" - --nd-min-eigenvalue one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --nd-min-eigenvalue nan one_point.xyz
 python3 -c "
 import sys
 print('0.25 0.5 0.75\n' * 500, end='')" > duplicates.xyz

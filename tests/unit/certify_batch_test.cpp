@@ -4,7 +4,9 @@
 // back field by field.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <functional>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -238,7 +240,8 @@ TEST_CASE("--eps-oc auto: eps_oc from the clouds and the oc distances, every oc 
   std::vector<double> distances;
   for (int i = 0; i < kClouds; ++i) {
     const PoseEstimate e = EstimateAndCertify(f.object, f.clouds[i], f.detected[i], f.Options().pipeline);
-    if (e.ok()) distances.push_back(e.certificate.oc.max_point_distance);
+    if (e.ok()) distances.push_back(e.certificate.oc.budget_distance);   // m = 0: the maximum
+    if (e.ok()) CHECK(e.certificate.oc.budget_distance == e.certificate.oc.max_point_distance);
   }
   const AutoEpsOcResult expected = EstimateEpsOc(f.object, f.clouds, AutoEpsOcOptions{}, &distances);
   CHECK(result.auto_eps_oc->eps_oc == expected.eps_oc);
@@ -260,6 +263,63 @@ TEST_CASE("--eps-oc auto: eps_oc from the clouds and the oc distances, every oc 
   CHECK(result.oc == again.oc);
 }
 
+TEST_CASE("--eps-oc auto with a budget m: the m farthest points never set eps_oc; oc_m and nd_m decided again") {
+  const Fixture f;
+  constexpr int kStray = 3;
+  // Every cloud gets kStray points moved one diameter away (stray pixels).
+  std::vector<PointSet> clouds = f.clouds;
+  for (PointSet& cloud : clouds) {
+    for (int j = 0; j < kStray; ++j) cloud.col(j * 7) += Eigen::Vector3d(1.0, 0.5 * j, -0.3) * f.object.diameter();
+  }
+  CertifyBatchOptions options = f.Options();
+  options.pipeline.certificate.max_outliers.count = kStray;
+  // The corrector's restart distance defaults to eps_oc: fixed here so that the
+  // estimates do not depend on the eps_oc being decided.
+  options.pipeline.corrector.fast_restart_distance = f.object.spec().eps_oc;
+  CertifyBatchOptions automatic = options;
+  automatic.auto_eps_oc = true;
+  const CertifyBatchResult result = CertifyBatch(f.object, InMemorySources(clouds, f.detected), nullptr, automatic);
+  REQUIRE(result.auto_eps_oc.has_value());
+  // Oracle: the (m+1)-th largest point distance of each estimate, sorted by hand.
+  std::vector<double> budget_distances, max_distances;
+  for (int i = 0; i < kClouds; ++i) {
+    const PoseEstimate e = EstimateAndCertify(f.object, clouds[i], f.detected[i], options.pipeline);
+    if (!e.ok()) continue;
+    std::vector<double> d(e.certificate.oc.point_distances.data(),
+                          e.certificate.oc.point_distances.data() + e.certificate.oc.point_distances.size());
+    std::sort(d.begin(), d.end(), std::greater<double>());
+    budget_distances.push_back(d[kStray]);
+    max_distances.push_back(d[0]);
+    CHECK(max_distances.back() > 0.5 * f.object.diameter());   // the stray points are there
+  }
+  const AutoEpsOcResult expected = EstimateEpsOc(f.object, clouds, AutoEpsOcOptions{}, &budget_distances);
+  const AutoEpsOcResult from_max = EstimateEpsOc(f.object, clouds, AutoEpsOcOptions{}, &max_distances);
+  CHECK(result.auto_eps_oc->eps_oc == expected.eps_oc);
+  CHECK(result.auto_eps_oc->eps_oc < 0.5 * f.object.diameter());
+  CHECK(from_max.eps_oc >= result.auto_eps_oc->eps_oc);
+  // Each decision (oc_m, nd_m with the local test, certified) equals a run
+  // with eps_oc fixed to the chosen value.
+  CertifyBatchOptions fixed = options;
+  fixed.pipeline.certificate.eps_oc = expected.eps_oc;
+  const CertifyBatchResult again = CertifyBatch(f.object, InMemorySources(clouds, f.detected), nullptr, fixed);
+  int certified = 0;
+  for (int i = 0; i < kClouds; ++i) {
+    CAPTURE(i);
+    const Certificate& a = result.outcomes[i].estimate.certificate;
+    const Certificate& b = again.outcomes[i].estimate.certificate;
+    CHECK(a.oc.passed == b.oc.passed);
+    CHECK(a.oc.outlier_count == b.oc.outlier_count);
+    CHECK(a.nd.passed == b.nd.passed);
+    CHECK(a.nd.keypoint_support == b.nd.keypoint_support);
+    CHECK(a.nd.local.min_eigenvalue == b.nd.local.min_eigenvalue);
+    certified += a.oc.passed && a.nd.passed;
+  }
+  CHECK(result.certified == again.certified);
+  CHECK(result.nd == again.nd);
+  CHECK(certified == result.certified);
+  CHECK(result.oc > 0);   // the budget absorbs the stray points (nd_m may still refuse: > m supports)
+}
+
 TEST_CASE("CertifyBatch stops when an interrupt is requested") {
   const Fixture f;
   RequestInterrupt();
@@ -279,7 +339,11 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   for (auto it = j.begin(); it != j.end(); ++it) keys.push_back(it.key());
   CHECK(keys == std::vector<std::string>{"cloud", "R", "t", "keypoints", "oc", "nd", "certified", "oc_distance",
                                          "keypoint_distance", "nd_set", "nd_set_distances", "eps_oc", "delta_nd",
-                                         "iterations", "cost_before", "cost_after", "status", "ms"});
+                                         "iterations", "cost_before", "cost_after", "status", "max_outliers",
+                                         "outliers", "outlier_indices", "outlier_indices_truncated",
+                                         "distance_quantiles", "max_inlier_distance", "keypoint_support",
+                                         "nd_set_support", "nd_sets", "nd_local", "nd_local_eigenvalue",
+                                         "nd_local_motion", "nd_local_rank", "ms"});
   CHECK(j["cloud"] == "a.ply");
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) CHECK(j["R"][r][c].get<double>() == e.scene_from_model.R(r, c));
@@ -291,6 +355,39 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   CHECK(j["oc_distance"].get<double>() == e.certificate.oc.max_point_distance);
   CHECK(j["eps_oc"].get<double>() == e.certificate.oc.eps_oc);
   CHECK(j["iterations"].get<int>() == e.correction.iterations);
+  // Outlier-robust evidence, read back against the certificate.
+  const ObservableCorrectness& oc = e.certificate.oc;
+  const NonDegeneracy& nd = e.certificate.nd;
+  CHECK(j["max_outliers"].get<int>() == oc.max_outliers);
+  CHECK(j["outliers"].get<int>() == oc.outlier_count);
+  CHECK(j["outlier_indices"].get<std::vector<int>>() == oc.outlier_indices);
+  CHECK(j["outlier_indices_truncated"].get<bool>() == false);
+  REQUIRE(j["distance_quantiles"].size() == 4);
+  CHECK(j["distance_quantiles"][0].get<double>() == oc.quantile50);
+  CHECK(j["distance_quantiles"][3].get<double>() == oc.max_point_distance);
+  CHECK(j["max_inlier_distance"].get<double>() == oc.max_inlier_distance);
+  CHECK(j["keypoint_support"].get<std::vector<int>>() == nd.keypoint_support);
+  CHECK(j["nd_set_support"].get<std::vector<int>>() == nd.set_min_support);
+  CHECK(j["nd_sets"].get<bool>() == nd.sets_passed);
+  REQUIRE(nd.local_checked);
+  CHECK(j["nd_local"].get<bool>() == nd.local.passed);
+  CHECK(j["nd_local_eigenvalue"].get<double>() == nd.local.min_eigenvalue);
+  REQUIRE(j["nd_local_motion"].size() == 6);
+  for (int k = 0; k < 6; ++k) CHECK(j["nd_local_motion"][k].get<double>() == nd.local.motion(k));
+  CHECK(j["nd_local_rank"].get<int>() == nd.local.model_rank);
+  // Outlier indices are capped at kMaxListedOutliers; the count stays exact.
+  PoseEstimate many = e;
+  many.certificate.oc.outlier_indices.resize(kMaxListedOutliers + 5);
+  for (std::size_t k = 0; k < many.certificate.oc.outlier_indices.size(); ++k) many.certificate.oc.outlier_indices[k] = static_cast<int>(k);
+  many.certificate.oc.outlier_count = static_cast<int>(kMaxListedOutliers + 5);
+  const nlohmann::json capped = nlohmann::json::parse(CertifyJsonLine("m.ply", many));
+  CHECK(capped["outlier_indices"].size() == kMaxListedOutliers);
+  CHECK(capped["outlier_indices_truncated"].get<bool>());
+  CHECK(capped["outliers"].get<int>() == static_cast<int>(kMaxListedOutliers + 5));
+  // With the local test off, nd_local is null.
+  PoseEstimate off = e;
+  off.certificate.nd.local_checked = false;
+  CHECK(nlohmann::json::parse(CertifyJsonLine("o.ply", off))["nd_local"].is_null());
   // Non-finite numbers become null; errors have their own line.
   PoseEstimate failed = e;
   failed.certificate.oc.max_point_distance = std::numeric_limits<double>::infinity();

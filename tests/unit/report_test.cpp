@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -198,6 +199,59 @@ TEST_CASE("3D views: selected examples decode to the subsampled clouds and posed
   const std::string plain = ReportHtml(input);
   CHECK(ScriptBody(plain, "c3po-three").empty());
   CHECK(CheckHtml(plain) == "");
+}
+
+TEST_CASE("3D views: the outliers of each estimate (input points at >= eps_oc) are a layer of their own") {
+  Fixture f;
+  // A tight eps_oc so that estimates have outliers; oracle: brute-force
+  // distances from each input point to the posed model sample.
+  EvaluationOptions options = EvaluationOptions::Defaults(f.object);
+  options.run_icp = false;
+  options.pipeline.certificate.eps_oc = 0.004 * f.object.diameter();
+  const Evaluation evaluation = Evaluate(f.object, f.dataset, {{"sim", nullptr, false}}, options);
+  const EvaluationRow& row = *evaluation.MainRow();
+  int with_outliers = 0;
+  for (const auto& s : row.samples) {
+    if (!s.ok()) continue;
+    const PointSet cloud = f.dataset.LoadCloud(s.index);
+    const PointSet local = s.scene_from_model.InverseApply(cloud);   // model frame, as the certificate
+    std::vector<int> expected;
+    for (Eigen::Index j = 0; j < cloud.cols(); ++j) {
+      const double d = std::sqrt((f.object.sample().colwise() - local.col(j)).colwise().squaredNorm().minCoeff());
+      if (!(d < options.pipeline.certificate.eps_oc)) expected.push_back(static_cast<int>(j));
+    }
+    CHECK(s.outlier_indices == expected);
+    with_outliers += !expected.empty();
+  }
+  REQUIRE(with_outliers > 0);
+  const std::vector<ReportView> views = SelectReportViews(f.object, f.dataset, row, options.adds_threshold, {3, 3, 100000});
+  REQUIRE(!views.empty());
+  ReportInput input;
+  input.evaluation = &evaluation;
+  input.views = views;
+  const std::string html = ReportHtml(input);
+  CHECK(CheckHtml(html) == "");
+  CHECK(html.find("id=\"layer-outliers\"") != std::string::npos);
+  const nlohmann::json data = nlohmann::json::parse(ScriptBody(html, "c3po-views"));
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const SampleResult* sample = nullptr;
+    for (const auto& s : row.samples) {
+      if (s.cloud == views[k].cloud) sample = &s;
+    }
+    REQUIRE(sample != nullptr);
+    const PointSet cloud = f.dataset.LoadCloud(sample->index);
+    REQUIRE(views[k].outliers.cols() == static_cast<Eigen::Index>(sample->outlier_indices.size()));
+    for (std::size_t i = 0; i < sample->outlier_indices.size(); ++i) {
+      CHECK((views[k].outliers.col(static_cast<Eigen::Index>(i)) - cloud.col(sample->outlier_indices[i])).norm() == 0.0);
+    }
+    CHECK(Base64Floats(data["views"][k]["outliers"]) == 3 * sample->outlier_indices.size());
+  }
+  // Indices outside the cloud (a stale result) are dropped, not read.
+  EvaluationRow stale = row;
+  for (auto& s : stale.samples) s.outlier_indices = {-1, 0, 1 << 30};
+  for (const ReportView& v : SelectReportViews(f.object, f.dataset, stale, options.adds_threshold, {2, 2, 100})) {
+    CHECK(v.outliers.cols() == 1);
+  }
 }
 
 TEST_CASE("training logs are read (numeric fields) and plotted; malformed lines are input errors") {

@@ -107,6 +107,7 @@ IndicatorCoverage MeasureIndicatorCoverage(const ObjectModel& object, const Data
   CertificateOptions options;
   options.eps_oc = delta_nd;   // unused by CheckNonDegeneracy, must be valid
   options.delta_nd = delta_nd;
+  options.local_nondegeneracy = false;   // coverage of the sets alone
   options.Check();
   std::vector<NonDegeneracy> results(n);
   std::atomic<std::size_t> done{0};

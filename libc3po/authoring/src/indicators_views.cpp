@@ -37,16 +37,6 @@ Eigen::Matrix3d LookAtRotation(const Eigen::Vector3d& direction, double roll) {
   return model_from_camera.transpose();
 }
 
-// Hausdorff(T1·B̂, T2·B̂) = Hausdorff(B̂, T·B̂), T = T1^-1 T2, with a subsample
-// Q of B̂ as queries and the model tree as targets (no rebuild).
-double PosedModelHausdorff(const ObjectModel& object, const PointSet& queries, const Pose& first,
-                           const Pose& second) {
-  const Pose relative = first.Inverse() * second;
-  const double forward = object.DistancesToPosedModel(relative * queries, Pose::Identity()).maxCoeff();
-  const double backward = object.DistancesToPosedModel(queries, relative).maxCoeff();
-  return std::max(forward, backward);
-}
-
 double MaxDistance(const ObjectModel& object, const PointSet& cloud, const Pose& pose) {
   return object.DistancesToPosedModel(cloud, pose).maxCoeff();
 }

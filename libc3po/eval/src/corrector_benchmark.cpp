@@ -1,9 +1,11 @@
 #include "c3po/eval/corrector_benchmark.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <ctime>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 
@@ -13,6 +15,7 @@
 #include "c3po/base/random.hpp"
 #include "c3po/eval/metrics.hpp"
 #include "c3po/geometry/registration.hpp"
+#include "c3po/synth/stray_points.hpp"
 #include "c3po/synth/synth.hpp"
 
 namespace c3po {
@@ -23,6 +26,8 @@ void CorrectorBenchmarkOptions::Check() const {
     if (!(s >= 0 && std::isfinite(s))) throw std::invalid_argument("sigma must be >= 0");
   }
   if (!(fraction >= 0 && fraction <= 1)) throw std::invalid_argument("fraction must be in [0, 1]");
+  if (!(stray_fraction >= 0 && stray_fraction < 10)) throw std::invalid_argument("stray_fraction must be in [0, 10)");
+  if (!(correct_hausdorff > 0 && std::isfinite(correct_hausdorff))) throw std::invalid_argument("correct_hausdorff must be > 0");
   corrector.Check();
   certificate.Check();
 }
@@ -46,7 +51,7 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 // correction (robust to other processes sharing the cores).
 Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& detected,
               const DatasetEntry& entry, const std::optional<CorrectorSolver>& solver,
-              const CorrectorBenchmarkOptions& options) {
+              const CorrectorBenchmarkOptions& options, const PointSet& hausdorff_queries) {
   Sample out{};
   const double cpu_start = ThreadCpuMilliseconds();
   const auto start = std::chrono::steady_clock::now();
@@ -58,6 +63,7 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
     corrector.solver = *solver;
     // Restarts follow the threshold certified here (as in the pipeline).
     if (corrector.fast_restart_distance < 0) corrector.fast_restart_distance = options.certificate.eps_oc;
+    if (corrector.robust_scale < 0) corrector.robust_scale = options.certificate.eps_oc;
     const CorrectorResult result = CorrectKeypoints(object, cloud, detected, corrector);
     ok = result.ok();
     pose = result.scene_from_model;
@@ -73,8 +79,14 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
   out.corrector_ms = MillisecondsSince(start);
   out.corrector_cpu_ms = ThreadCpuMilliseconds() - cpu_start;
   const auto certify_start = std::chrono::steady_clock::now();
-  out.oc = ok && Certify(object, cloud, pose, keypoints, options.certificate).oc.passed;
+  const Certificate certificate = ok ? Certify(object, cloud, pose, keypoints, options.certificate) : Certificate{};
+  out.oc = ok && certificate.oc.passed;
+  out.certified = ok && certificate.certified();
+  out.nd_local = ok && certificate.nd.local.passed;
+  out.nd_eigenvalue = certificate.nd.local.min_eigenvalue;
   out.certify_ms = MillisecondsSince(certify_start);
+  out.hausdorff = ok ? PosedModelHausdorff(object, hausdorff_queries, *entry.pose, pose)
+                     : std::numeric_limits<double>::infinity();
   const double d = object.diameter();
   out.rotation_deg = RotationError(pose.R, entry.pose->R) * 180.0 / M_PI;
   out.translation_over_d = TranslationError(pose.t, entry.pose->t) / d;
@@ -82,7 +94,8 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
   return out;
 }
 
-CorrectorBenchmarkRow Summarise(double sigma, const std::string& method, const std::vector<Sample>& samples) {
+CorrectorBenchmarkRow Summarise(double sigma, const std::string& method, const std::vector<Sample>& samples,
+                                double correct_hausdorff) {
   CorrectorBenchmarkRow row;
   row.sigma = sigma;
   row.method = method;
@@ -118,6 +131,29 @@ CorrectorBenchmarkRow Summarise(double sigma, const std::string& method, const s
   row.median_corrector_cpu_ms = Median(corrector_cpu_ms);
   row.median_certify_ms = Median(certify_ms);
   row.mean_iterations = samples.empty() ? 0.0 : iterations / static_cast<double>(samples.size());
+  int certified = 0, correct = 0, correct_certified = 0, nd_local = 0;
+  std::vector<double> hausdorff, correct_eigenvalues;
+  for (const auto& s : samples) {
+    const bool is_correct = s.hausdorff <= correct_hausdorff;
+    certified += s.certified;
+    correct += is_correct;
+    correct_certified += is_correct && s.certified;
+    nd_local += s.nd_local;
+    if (s.certified && !is_correct) ++row.false_certificates;
+    if (s.certified) row.max_certified_hausdorff = std::max(row.max_certified_hausdorff, s.hausdorff);
+    hausdorff.push_back(s.hausdorff);
+    if (is_correct) correct_eigenvalues.push_back(s.nd_eigenvalue);
+  }
+  const double count = std::max<double>(1.0, static_cast<double>(samples.size()));
+  row.percent_certified = 100.0 * certified / count;
+  row.percent_correct = 100.0 * correct / count;
+  row.percent_correct_certified = correct > 0 ? 100.0 * correct_certified / correct : 0.0;
+  row.percent_nd_local = 100.0 * nd_local / count;
+  row.median_hausdorff = Median(hausdorff);
+  if (!correct_eigenvalues.empty()) {
+    std::sort(correct_eigenvalues.begin(), correct_eigenvalues.end());
+    row.q05_nd_eigenvalue_correct = correct_eigenvalues[correct_eigenvalues.size() / 20];
+  }
   return row;
 }
 
@@ -133,7 +169,15 @@ std::vector<CorrectorBenchmarkRow> RunCorrectorBenchmark(const ObjectModel& obje
   std::size_t count = dataset.entries.size();
   if (options.max_clouds > 0) count = std::min<std::size_t>(count, options.max_clouds);
   std::vector<PointSet> clouds(count);
-  ParallelFor(0, static_cast<int>(count), [&](int i) { clouds[i] = dataset.LoadCloud(i); });
+  ParallelFor(0, static_cast<int>(count), [&](int i) {
+    clouds[i] = dataset.LoadCloud(i);
+    if (options.stray_fraction > 0) {
+      Rng rng = Rng::ForItem(options.seed ^ 0x5157a9ULL, static_cast<std::uint64_t>(i));
+      const int stray = static_cast<int>(std::floor(options.stray_fraction * static_cast<double>(clouds[i].cols())));
+      clouds[i] = AddStrayPoints(clouds[i], stray, object.diameter(), rng);
+    }
+  });
+  const PointSet hausdorff_queries = StridedColumns(object.sample(), 2000);
 
   // Methods: registration alone, then the corrector with each solver.
   std::vector<std::pair<std::string, std::optional<CorrectorSolver>>> methods = {{"registration", std::nullopt}};
@@ -157,14 +201,14 @@ std::vector<CorrectorBenchmarkRow> RunCorrectorBenchmark(const ObjectModel& obje
         // The same perturbation for every method at this sigma.
         Rng rng = Rng::ForItem(options.seed + 7919 * s, static_cast<std::uint64_t>(i));
         const PointSet detected = PerturbKeypoints(*entry.keypoints, sigma, options.fraction, d, rng);
-        samples[i] = RunOne(object, clouds[i], detected, entry, solver, options);
+        samples[i] = RunOne(object, clouds[i], detected, entry, solver, options, hausdorff_queries);
         samples[i].sigma = sigma;
         samples[i].method = method;
         samples[i].cloud = i;
         samples[i].detected_keypoints = detected;
         if (progress) progress(++done, total);
       }, options.threads);
-      rows.push_back(Summarise(sigma, method, samples));
+      rows.push_back(Summarise(sigma, method, samples, options.correct_hausdorff));
       if (cases) cases->insert(cases->end(), samples.begin(), samples.end());
     }
   }

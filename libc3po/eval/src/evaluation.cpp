@@ -64,6 +64,7 @@ SampleResult FromEstimate(std::size_t index, const std::string& cloud, const Pos
   sample.oc = estimate.certificate.oc.passed;
   sample.nd = estimate.certificate.nd.passed;
   sample.oc_distance = estimate.certificate.oc.max_point_distance;
+  sample.outlier_indices = estimate.certificate.oc.outlier_indices;
   sample.milliseconds = estimate.milliseconds;
   return sample;
 }
@@ -91,6 +92,7 @@ SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
   sample.oc = certificate.oc.passed;
   sample.nd = certificate.nd.passed;
   sample.oc_distance = certificate.oc.max_point_distance;
+  sample.outlier_indices = certificate.oc.outlier_indices;
   sample.milliseconds = registration.milliseconds +
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return sample;

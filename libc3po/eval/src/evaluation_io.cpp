@@ -64,10 +64,15 @@ std::string SettingsLines(const Evaluation& e) {
                 o.auc_max, Percent(o.auc_max, e.diameter).c_str(), e.diameter);
   out << line;
   std::snprintf(line, sizeof line,
-                "Certificates: eps_oc = %.6g (%s), delta_nd = %.6g (%s); corrector %s solver, %s loss.\n",
+                "Certificates: eps_oc = %.6g (%s), delta_nd = %.6g (%s), outlier budget m = %s, local nd %s; "
+                "corrector %s solver, %s loss, robust kernel %s.\n",
                 o.pipeline.certificate.eps_oc, Percent(o.pipeline.certificate.eps_oc, e.diameter).c_str(),
                 o.pipeline.certificate.delta_nd, Percent(o.pipeline.certificate.delta_nd, e.diameter).c_str(),
-                ToString(o.pipeline.corrector.solver), ToString(o.pipeline.corrector.loss));
+                o.pipeline.certificate.max_outliers.ToString().c_str(),
+                o.pipeline.certificate.local_nondegeneracy
+                    ? (">= " + std::to_string(o.pipeline.certificate.local.min_eigenvalue)).c_str() : "off",
+                ToString(o.pipeline.corrector.solver), ToString(o.pipeline.corrector.loss),
+                ToString(o.pipeline.corrector.robust_loss));
   out << line;
   return out.str();
 }

@@ -192,12 +192,6 @@ AutoEpsOcResult EstimateEpsOc(const ObjectModel& object, const std::vector<Point
   return result;
 }
 
-void RethresholdObservableCorrectness(ObservableCorrectness* oc, double eps_oc, bool check_keypoint_agreement) {
-  oc->eps_oc = eps_oc;
-  oc->passed = oc->max_point_distance < eps_oc &&
-               (!check_keypoint_agreement || oc->max_keypoint_distance < eps_oc);
-}
-
 std::string AutoEpsOcResult::ToJson() const {
   nlohmann::json doc;
   doc["eps_oc"] = eps_oc;

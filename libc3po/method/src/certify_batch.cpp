@@ -15,8 +15,11 @@ namespace c3po {
 namespace {
 
 // --eps-oc auto (docs/method.md "Automatic eps_oc"): eps_oc from the clouds
-// that were processed and the oc distances of their estimates, then every oc
-// decision is taken again with it.
+// that were processed and the oc distances of their estimates, then both
+// certificates are decided again with it. With a budget m the distance used is
+// each cloud's (m+1)-th largest point distance (budget_distance: the m
+// farthest points never set eps_oc), and nd is decided again too: nd_m and the
+// local test count only the points accepted under the new eps_oc.
 AutoEpsOcResult DecideAutoEpsOc(const ObjectModel& object, const std::vector<PointSet>& clouds,
                                 const CertifyBatchOptions& options, CertifyBatchResult* result) {
   std::vector<PointSet> usable;
@@ -25,23 +28,25 @@ AutoEpsOcResult DecideAutoEpsOc(const ObjectModel& object, const std::vector<Poi
     const CloudOutcome& outcome = result->outcomes[i];
     if (!outcome.processed()) continue;
     usable.push_back(clouds[i]);
-    if (outcome.estimate.ok()) oc_distances.push_back(outcome.estimate.certificate.oc.max_point_distance);
+    if (outcome.estimate.ok()) oc_distances.push_back(outcome.estimate.certificate.oc.budget_distance);
   }
   const AutoEpsOcResult chosen = EstimateEpsOc(object, usable, options.auto_eps_oc_options, &oc_distances);
-  const bool agreement = options.pipeline.certificate.check_keypoint_agreement;
+  CertificateOptions decided = options.pipeline.certificate;
+  decided.eps_oc = chosen.eps_oc;
   // Only estimates that have a pose have oc evidence: a failed registration
   // keeps oc = 0 (its distances were never computed) and records eps_oc.
-  const auto decide = [&](PoseEstimate* estimate) {
+  const auto decide = [&](const PointSet& cloud, PoseEstimate* estimate) {
     if (estimate->ok()) {
-      RethresholdObservableCorrectness(&estimate->certificate.oc, chosen.eps_oc, agreement);
+      estimate->certificate = Certify(object, cloud, estimate->scene_from_model, estimate->keypoints, decided);
     } else {
       estimate->certificate.oc.eps_oc = chosen.eps_oc;
     }
   };
-  for (CloudOutcome& outcome : result->outcomes) {
+  for (std::size_t i = 0; i < result->outcomes.size(); ++i) {
+    CloudOutcome& outcome = result->outcomes[i];
     if (!outcome.processed()) continue;
-    decide(&outcome.estimate);
-    if (outcome.uncorrected) decide(&outcome.uncorrected.value());
+    decide(clouds[i], &outcome.estimate);
+    if (outcome.uncorrected) decide(clouds[i], &outcome.uncorrected.value());
   }
   return chosen;
 }

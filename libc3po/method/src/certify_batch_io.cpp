@@ -1,4 +1,5 @@
 // The JSON lines of `c3po certify` (schema in certify_batch.hpp).
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -33,6 +34,25 @@ std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& e) {
   line["cost_before"] = FiniteOrNull(e.correction.cost_before);
   line["cost_after"] = FiniteOrNull(e.correction.cost_after);
   line["status"] = ToString(e.correction.registration);
+  // Outlier-robust evidence (docs/method.md "Outlier-robust certificates").
+  const ObservableCorrectness& oc = e.certificate.oc;
+  const NonDegeneracy& nd = e.certificate.nd;
+  line["max_outliers"] = oc.max_outliers;
+  line["outliers"] = oc.outlier_count;
+  const std::size_t listed = std::min(oc.outlier_indices.size(), kMaxListedOutliers);
+  line["outlier_indices"] = std::vector<int>(oc.outlier_indices.begin(), oc.outlier_indices.begin() + listed);
+  line["outlier_indices_truncated"] = listed < oc.outlier_indices.size();
+  line["distance_quantiles"] = {FiniteOrNull(oc.quantile50), FiniteOrNull(oc.quantile90),
+                                FiniteOrNull(oc.quantile99), FiniteOrNull(oc.max_point_distance)};
+  line["max_inlier_distance"] = oc.max_inlier_distance;
+  line["keypoint_support"] = nd.keypoint_support;
+  line["nd_set_support"] = nd.set_min_support;
+  line["nd_sets"] = nd.sets_passed;
+  line["nd_local"] = nd.local_checked ? nlohmann::ordered_json(nd.local.passed) : nlohmann::ordered_json(nullptr);
+  line["nd_local_eigenvalue"] = FiniteOrNull(nd.local.min_eigenvalue);
+  line["nd_local_motion"] = {nd.local.motion(0), nd.local.motion(1), nd.local.motion(2),
+                             nd.local.motion(3), nd.local.motion(4), nd.local.motion(5)};
+  line["nd_local_rank"] = nd.local.model_rank;
   line["ms"] = e.milliseconds;
   return line.dump();
 }

@@ -16,6 +16,35 @@ const char* ToString(PointCloudLoss loss) {
 const char* ToString(CorrectorSolver solver) {
   return solver == CorrectorSolver::kFast ? "fast" : "gd";
 }
+const char* ToString(RobustLoss loss) {
+  switch (loss) {
+    case RobustLoss::kTruncated: return "tls";
+    case RobustLoss::kGemanMcClure: return "gm";
+    default: return "none";
+  }
+}
+RobustLoss ParseRobustLoss(const std::string& text) {
+  if (text == "none") return RobustLoss::kNone;
+  if (text == "tls") return RobustLoss::kTruncated;
+  if (text == "gm") return RobustLoss::kGemanMcClure;
+  throw InputError("--robust-loss", "'" + text + "' must be none, tls or gm");
+}
+double RobustRho(RobustLoss loss, double squared, double scale) {
+  const double c2 = scale * scale;
+  switch (loss) {
+    case RobustLoss::kTruncated: return std::min(squared, c2);
+    case RobustLoss::kGemanMcClure: return c2 * squared / (c2 + squared);
+    default: return squared;
+  }
+}
+double RobustWeight(RobustLoss loss, double squared, double scale) {
+  const double c2 = scale * scale;
+  switch (loss) {
+    case RobustLoss::kTruncated: return squared < c2 ? 1.0 : 0.0;
+    case RobustLoss::kGemanMcClure: return (c2 * c2) / ((c2 + squared) * (c2 + squared));
+    default: return 1.0;
+  }
+}
 PointCloudLoss ParsePointCloudLoss(const std::string& text) {
   if (text == "mean") return PointCloudLoss::kMeanSquared;
   if (text == "max") return PointCloudLoss::kMaxSquared;
@@ -44,9 +73,21 @@ void CorrectorOptions::Check() const {
   require(fast_polish_iterations >= 0, "fast_polish_iterations must be >= 0");
   require(std::isfinite(fast_restart_distance), "fast_restart_distance must be finite");
   require(fast_restart_angle >= 0 && fast_restart_angle <= M_PI, "fast_restart_angle must be in [0, pi]");
+  require(std::isfinite(robust_scale) && (robust_scale > 0 || robust_scale == -1.0),
+          "robust_scale must be > 0 or -1 (= eps_oc)");
+  require(robust_loss == RobustLoss::kNone || loss == PointCloudLoss::kMeanSquared,
+          "a robust kernel needs the mean loss");
 }
 
 namespace {
+
+// The robust kernel of the mean loss at one scale (kNone: plain squares).
+struct Kernel {
+  RobustLoss type = RobustLoss::kNone;
+  double scale = 0.0;
+  bool active() const { return type != RobustLoss::kNone; }
+  Kernel Scaled(double factor) const { return {type, scale * factor}; }
+};
 
 // L_pc of `points` at `pose`, with the nearest B̂ point of every input point.
 struct PoseFit {
@@ -57,14 +98,29 @@ struct PoseFit {
 };
 
 PoseFit FitAtPose(const ObjectModel& object, const PointSet& points, const Pose& pose,
-                  PointCloudLoss loss) {
+                  PointCloudLoss loss, const Kernel& kernel = {}) {
   PoseFit fit;
   fit.pose = pose;
   object.NearestInPosedModel(points, pose, &fit.nearest, &fit.squared);
   if (points.cols() > 0) {
-    fit.loss = loss == PointCloudLoss::kMeanSquared ? fit.squared.mean() : fit.squared.maxCoeff();
+    if (loss == PointCloudLoss::kMeanSquared && kernel.active()) {
+      double sum = 0.0;
+      for (Eigen::Index j = 0; j < fit.squared.size(); ++j) sum += RobustRho(kernel.type, fit.squared(j), kernel.scale);
+      fit.loss = sum / static_cast<double>(points.cols());
+    } else {
+      fit.loss = loss == PointCloudLoss::kMeanSquared ? fit.squared.mean() : fit.squared.maxCoeff();
+    }
   }
   return fit;
+}
+
+// IRLS weights rho'(d_j^2) of the kernel (empty = unit weights).
+Eigen::VectorXd KernelWeights(const Kernel& kernel, const Eigen::VectorXd& squared) {
+  Eigen::VectorXd weights;
+  if (!kernel.active()) return weights;
+  weights.resize(squared.size());
+  for (Eigen::Index j = 0; j < squared.size(); ++j) weights(j) = RobustWeight(kernel.type, squared(j), kernel.scale);
+  return weights;
 }
 
 struct StageResult {
@@ -84,9 +140,11 @@ bool SmallDecrease(double previous, double current, double tolerance) {
 // the reference's small gradient steps achieve, in far fewer iterations).
 // With IRLS weights w_j = d_j^(p-2) it minimises sum d_j^p, which tends to
 // the max loss.
+// With a robust kernel the weights are w_j = rho'(d_j^2) (IRLS; for TLS an
+// MM step on the points within the truncation).
 StageResult RunPointToPointStage(const ObjectModel& object, const PointSet& points, PoseFit fit,
                                  PointCloudLoss loss, double irls_power, int max_iterations,
-                                 double tolerance) {
+                                 double tolerance, const Kernel& kernel = {}) {
   StageResult stage{fit};
   PointSet matched(3, points.cols());
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
@@ -95,12 +153,14 @@ StageResult RunPointToPointStage(const ObjectModel& object, const PointSet& poin
       const double scale = std::max(fit.squared.maxCoeff(), 1e-300);
       weights = (fit.squared / scale).array().pow(0.5 * (irls_power - 2.0)).matrix();
       weights = weights.cwiseMax(1e-12);
+    } else if (kernel.active()) {
+      weights = KernelWeights(kernel, fit.squared);
     }
     for (Eigen::Index j = 0; j < points.cols(); ++j) matched.col(j) = object.sample().col(fit.nearest(j));
     const RegistrationResult step = RegisterPoints(matched, points, weights);
     if (!step.ok()) break;
     const double previous = fit.loss;
-    fit = FitAtPose(object, points, step.scene_from_model, loss);
+    fit = FitAtPose(object, points, step.scene_from_model, loss, kernel);
     ++stage.iterations;
     if (fit.loss < stage.best.loss) stage.best = fit;
     if (SmallDecrease(previous, fit.loss, tolerance)) {
@@ -132,20 +192,24 @@ Pose ApplyIncrement(const Pose& pose, const Eigen::Matrix<double, 6, 1>& delta) 
 // Gauss-Newton converges in a few steps near the optimum but from afar can
 // jump out of the start's basin; the acceptance test forbids that.
 StageResult RunPointToPlaneStage(const ObjectModel& object, const PointSet& points, PoseFit fit,
-                                 int max_iterations, double tolerance, int max_tries) {
+                                 int max_iterations, double tolerance, int max_tries,
+                                 const Kernel& kernel = {}) {
   StageResult stage;
   double damping = 1e-4;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> Jtr = Eigen::Matrix<double, 6, 1>::Zero();
+    const Eigen::VectorXd weights = KernelWeights(kernel, fit.squared);   // IRLS (empty: unit)
     for (Eigen::Index j = 0; j < points.cols(); ++j) {
+      const double w = weights.size() ? weights(j) : 1.0;
+      if (w == 0.0) continue;
       const Eigen::Vector3d x = points.col(j);
       const Eigen::Vector3d m = fit.pose.R * object.sample_normals().col(fit.nearest(j));
       const Eigen::Vector3d s = fit.pose.R * object.sample().col(fit.nearest(j)) + fit.pose.t;
       Eigen::Matrix<double, 6, 1> J;
       J << m.cross(x), -m;
-      JtJ.noalias() += J * J.transpose();
-      Jtr.noalias() += J * m.dot(x - s);
+      JtJ.noalias() += w * J * J.transpose();
+      Jtr.noalias() += w * J * m.dot(x - s);
     }
     const double floor = 1e-12 * (JtJ.trace() + 1e-300);
     bool accepted = false;
@@ -156,7 +220,7 @@ StageResult RunPointToPlaneStage(const ObjectModel& object, const PointSet& poin
       const Eigen::Matrix<double, 6, 1> delta = damped.ldlt().solve(-Jtr);
       if (!delta.allFinite()) break;
       PoseFit candidate = FitAtPose(object, points, ApplyIncrement(fit.pose, delta),
-                                    PointCloudLoss::kMeanSquared);
+                                    PointCloudLoss::kMeanSquared, kernel);
       ++stage.iterations;
       if (candidate.loss < fit.loss) {
         fit = std::move(candidate);
@@ -201,23 +265,44 @@ struct Refined {
   bool converged = false;
 };
 
+// With a robust kernel the basin stage is graduated (GNC): the kernel's scale
+// starts at 8c (nearly quadratic over the basin, so a far start still sees
+// every point) and halves to c; later stages use scale c.
 Refined RefineMean(const ObjectModel& object, const PointSet& cloud, const PointSet& coarse,
-                   const PointSet& subset, const Pose& start, const CorrectorOptions& options) {
+                   const PointSet& subset, const Pose& start, const CorrectorOptions& options,
+                   const Kernel& kernel = {}) {
   const PointCloudLoss mean = PointCloudLoss::kMeanSquared;
   int budget = options.fast_max_iterations;
   auto spend = [&budget](const StageResult& stage) { budget = std::max(0, budget - stage.iterations); };
-  const StageResult basin = RunPointToPointStage(object, coarse, FitAtPose(object, coarse, start, mean),
-                                                 mean, 2.0, std::min(budget, options.fast_basin_iterations), 1e-3);
-  spend(basin);
-  const StageResult local = RunPointToPlaneStage(object, subset, FitAtPose(object, subset, basin.best.pose, mean),
-                                                 std::min(budget, 25), 1e-3, 4);
+  StageResult basin;
+  if (!kernel.active()) {
+    basin = RunPointToPointStage(object, coarse, FitAtPose(object, coarse, start, mean),
+                                 mean, 2.0, std::min(budget, options.fast_basin_iterations), 1e-3);
+    spend(basin);
+  } else {
+    Pose pose = start;
+    int iterations = 0;
+    for (double factor : {8.0, 4.0, 2.0, 1.0}) {
+      const Kernel graduated = kernel.Scaled(factor);
+      const int stage_budget = std::min(budget, std::max(2, options.fast_basin_iterations / 2));
+      const StageResult step = RunPointToPointStage(object, coarse, FitAtPose(object, coarse, pose, mean, graduated),
+                                                    mean, 2.0, stage_budget, 1e-3, graduated);
+      spend(step);
+      iterations += step.iterations;
+      pose = step.best.pose;
+    }
+    basin.best = FitAtPose(object, coarse, pose, mean, kernel);
+    basin.iterations = iterations;
+  }
+  const StageResult local = RunPointToPlaneStage(object, subset, FitAtPose(object, subset, basin.best.pose, mean, kernel),
+                                                 std::min(budget, 25), 1e-3, 4, kernel);
   spend(local);
-  const StageResult fine = RunPointToPlaneStage(object, cloud, FitAtPose(object, cloud, local.best.pose, mean),
-                                                std::min(budget, 5), 1e-4, 1);
+  const StageResult fine = RunPointToPlaneStage(object, cloud, FitAtPose(object, cloud, local.best.pose, mean, kernel),
+                                                std::min(budget, 5), 1e-4, 1, kernel);
   spend(fine);
   const StageResult polish = RunPointToPointStage(object, cloud, fine.best, mean, 2.0,
                                                   std::min(budget, options.fast_polish_iterations),
-                                                  options.fast_tolerance);
+                                                  options.fast_tolerance, kernel);
   return {polish.best, basin.iterations + local.iterations + fine.iterations + polish.iterations,
           fine.converged};
 }
@@ -229,10 +314,11 @@ Refined RefineMean(const ObjectModel& object, const PointSet& cloud, const Point
 // the best one, if it fits the coarse subset better, is refined, and kept if
 // its L_pc is lower. The same objective, minimised better.
 Refined TryRestarts(const ObjectModel& object, const PointSet& cloud, const PointSet& coarse,
-                    const PointSet& subset, Refined found, const CorrectorOptions& options) {
+                    const PointSet& subset, Refined found, const CorrectorOptions& options,
+                    const Kernel& kernel = {}) {
   const PointCloudLoss mean = PointCloudLoss::kMeanSquared;
   const Eigen::Vector3d centre = cloud.rowwise().mean();
-  PoseFit best_screen = FitAtPose(object, coarse, found.fit.pose, mean);
+  PoseFit best_screen = FitAtPose(object, coarse, found.fit.pose, mean, kernel);
   const double found_screen = best_screen.loss;
   for (int axis = 0; axis < 3; ++axis) {
     for (double sign : {-1.0, 1.0}) {
@@ -241,14 +327,14 @@ Refined TryRestarts(const ObjectModel& object, const PointSet& cloud, const Poin
       hypothesis.R = turn * found.fit.pose.R;
       hypothesis.t = turn * (found.fit.pose.t - centre) + centre;
       const StageResult screen =
-          RunPointToPointStage(object, coarse, FitAtPose(object, coarse, hypothesis, mean), mean, 2.0,
-                               options.fast_basin_iterations, 1e-3);
+          RunPointToPointStage(object, coarse, FitAtPose(object, coarse, hypothesis, mean, kernel), mean, 2.0,
+                               options.fast_basin_iterations, 1e-3, kernel);
       found.iterations += screen.iterations + 1;
       if (screen.best.loss < best_screen.loss) best_screen = screen.best;
     }
   }
   if (!(best_screen.loss < found_screen)) return found;
-  const Refined other = RefineMean(object, cloud, coarse, subset, best_screen.pose, options);
+  const Refined other = RefineMean(object, cloud, coarse, subset, best_screen.pose, options, kernel);
   found.iterations += other.iterations;
   if (other.fit.loss < found.fit.loss) {
     found.fit = other.fit;
@@ -261,12 +347,17 @@ CorrectorResult SolveFastMean(const ObjectModel& object, const PointSet& cloud, 
                               double start_loss, const CorrectorOptions& options, CorrectorResult result) {
   const PointSet coarse = StridedColumns(cloud, options.fast_coarse_subsample);
   const PointSet subset = StridedColumns(cloud, options.fast_subsample);
-  Refined refined = RefineMean(object, cloud, coarse, subset, start, options);
+  const Kernel kernel{options.robust_loss, options.robust_scale};
+  Refined refined = RefineMean(object, cloud, coarse, subset, start, options, kernel);
   const double restart_distance =
       options.fast_restart_distance < 0 ? object.spec().eps_oc : options.fast_restart_distance;
-  if (restart_distance > 0 && options.fast_restart_angle > 0 &&
-      refined.fit.squared.maxCoeff() >= restart_distance * restart_distance) {
-    refined = TryRestarts(object, cloud, coarse, subset, refined, options);
+  // Without a kernel one far point triggers restarts; with one, stray points
+  // are expected, so more than 1 % of the points (at least one) must be far.
+  const double restart_squared = restart_distance * restart_distance;
+  const Eigen::Index far = (refined.fit.squared.array() >= restart_squared).count();
+  const Eigen::Index allowed = kernel.active() ? cloud.cols() / 100 : 0;
+  if (restart_distance > 0 && options.fast_restart_angle > 0 && far > allowed) {
+    refined = TryRestarts(object, cloud, coarse, subset, refined, options, kernel);
   }
   result.iterations = refined.iterations;
   result.converged = refined.converged;
@@ -366,6 +457,14 @@ CorrectorResult CorrectKeypoints(const ObjectModel& object, const PointSet& clou
   CorrectorResult result;
   result.keypoints = detected_keypoints;
   result.posed_keypoints = detected_keypoints;
+  if (options.robust_loss != RobustLoss::kNone && options.robust_scale < 0) {
+    // Truncation tied to eps_oc: the object's, unless the caller set it.
+    CorrectorOptions resolved = options;
+    resolved.robust_scale = object.spec().eps_oc;
+    if (!(resolved.robust_scale > 0)) throw std::invalid_argument("CorrectKeypoints: robust kernel needs eps_oc > 0");
+    return CorrectKeypoints(object, cloud, detected_keypoints, resolved);
+  }
+  if (options.robust_loss != RobustLoss::kNone) result.robust_scale = options.robust_scale;
   const CorrectorObjectiveTerms start =
       EvaluateCorrectorObjective(object, cloud, detected_keypoints, options);
   result.registration = start.registration;

@@ -72,7 +72,16 @@ CorrectorObjectiveTerms EvaluateCorrectorObjective(const ObjectModel& object, co
     dL_dR -= scale * 2.0 * r * p.transpose();
     dL_dt -= scale * 2.0 * r;
   };
-  if (options.loss == PointCloudLoss::kMeanSquared) {
+  if (options.loss == PointCloudLoss::kMeanSquared && options.robust_loss != RobustLoss::kNone) {
+    // L_pc = (1/n) sum rho(d_j^2): chain rule, dL/dd_j^2 = rho'(d_j^2) / n.
+    const double scale = options.robust_scale > 0 ? options.robust_scale : object.spec().eps_oc;
+    double sum = 0.0;
+    for (Eigen::Index j = 0; j < cloud.cols(); ++j) {
+      sum += RobustRho(options.robust_loss, squared(j), scale);
+      if (gradient) accumulate(j, RobustWeight(options.robust_loss, squared(j), scale) / n);
+    }
+    terms.point_cloud_loss = sum / n;
+  } else if (options.loss == PointCloudLoss::kMeanSquared) {
     terms.point_cloud_loss = squared.mean();
     if (gradient) {
       for (Eigen::Index j = 0; j < cloud.cols(); ++j) accumulate(j, 1.0 / n);

@@ -27,6 +27,10 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
     if (corrector.fast_restart_distance < 0 && options.certificate.eps_oc > 0) {
       corrector.fast_restart_distance = options.certificate.eps_oc;
     }
+    // The robust kernel's truncation is the certified eps_oc (issue 16).
+    if (corrector.robust_scale < 0 && options.certificate.eps_oc > 0) {
+      corrector.robust_scale = options.certificate.eps_oc;
+    }
     estimate.correction = CorrectKeypoints(object, corrector_cloud, detected_keypoints, corrector);
   } else {
     // Registration only: y* = ỹ, T̂ = T(ỹ).

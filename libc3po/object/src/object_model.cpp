@@ -66,6 +66,20 @@ ObjectModel::ObjectModel(ObjectSpec spec, Mesh mesh, const ObjectModelOptions& o
   normals_ = std::move(normals);
   tree_ = std::make_shared<const PointTree>(std::move(sample.points));
   diameter_ = mesh_.Diameter();
+  // Crease flags: a sample point whose 8 nearest sample neighbours include a
+  // normal more than 30 degrees off its own lies at an edge or crease, where
+  // the nearest sample of a nearby point may carry the other side's normal.
+  auto crease = std::make_shared<std::vector<char>>(tree_->points().cols(), 0);
+  const double cos_limit = std::cos(30.0 * M_PI / 180.0);
+  for (Eigen::Index i = 0; i < tree_->points().cols(); ++i) {
+    for (const auto& nb : tree_->KNearest(tree_->points().col(i), 9)) {
+      if (normals_->col(nb.index).dot(normals_->col(i)) < cos_limit) {
+        (*crease)[i] = 1;
+        break;
+      }
+    }
+  }
+  crease_ = std::move(crease);
 }
 
 double ObjectModel::SampleSpacing() const {
@@ -111,6 +125,14 @@ Eigen::VectorXd ObjectModel::DistancesToPosedModel(const PointSet& scene,
   Eigen::VectorXd squared;
   NearestInPosedModel(scene, scene_from_model, nullptr, &squared);
   return squared.cwiseSqrt();
+}
+
+double PosedModelHausdorff(const ObjectModel& object, const PointSet& queries, const Pose& first,
+                           const Pose& second) {
+  const Pose relative = first.Inverse() * second;
+  const double forward = object.DistancesToPosedModel(relative * queries, Pose::Identity()).maxCoeff();
+  const double backward = object.DistancesToPosedModel(queries, relative).maxCoeff();
+  return std::max(forward, backward);
 }
 
 }  // namespace c3po

@@ -22,7 +22,7 @@ function countColoured(gl) {
   return count;
 }
 
-const colours = {input: 0x1f5fd6, certified: 0x2e8b57, rejected: 0xd04040, truth: 0x888888,
+const colours = {input: 0x1f5fd6, outliers: 0xe6194b, certified: 0x2e8b57, rejected: 0xd04040, truth: 0x888888,
                  keypoints: 0xf58231, detected: 0x911eb4};
 
 function makeViewer(THREE, box) {
@@ -105,13 +105,14 @@ function makeViewer(THREE, box) {
     layers.truth = points(truth, colours.truth, size * 0.8, 0.35);
     layers.posed = points(posed, view.certified ? colours.certified : colours.rejected, size * 0.8, 0.55);
     layers.input = points(input, colours.input, size, 1);
+    layers.outliers = points(decode(view.outliers), colours.outliers, size * 1.8, 1);
     layers.detected = new THREE.Group();
     if (detected.length) {
       layers.detected.add(spheres(detected, colours.detected, radius * 0.025));
       if (detected.length === keypoints.length) layers.detected.add(segments(detected, keypoints, colours.detected));
     }
     layers.keypoints = spheres(keypoints, colours.keypoints, radius * 0.03);
-    for (const name of ['truth', 'posed', 'input', 'detected', 'keypoints']) {
+    for (const name of ['truth', 'posed', 'input', 'outliers', 'detected', 'keypoints']) {
       layers[name].visible = document.getElementById('layer-' + name).checked;
       content.add(layers[name]);
     }
@@ -138,7 +139,7 @@ function makeViewer(THREE, box) {
     request();
   }, {passive: false});
   window.addEventListener('resize', request);
-  for (const name of ['truth', 'posed', 'input', 'detected', 'keypoints']) {
+  for (const name of ['truth', 'posed', 'input', 'outliers', 'detected', 'keypoints']) {
     document.getElementById('layer-' + name).addEventListener('change', event => {
       if (layers[name]) { layers[name].visible = event.target.checked; request(); }
     });

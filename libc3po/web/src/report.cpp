@@ -45,6 +45,7 @@ json ViewJson(const ReportView& v) {
           {"false_certificate", v.false_certificate}, {"adds", JsonNumber(v.adds)},
           {"rotation_error_deg", JsonNumber(v.rotation_error * kDegrees)},
           {"oc_distance", JsonNumber(v.oc_distance)}, {"input", web::PointsFloat32Base64(v.input)},
+          {"outliers", web::PointsFloat32Base64(v.outliers)},
           {"posed_model", web::PointsFloat32Base64(v.posed_model)}, {"truth_model", web::PointsFloat32Base64(v.truth_model)},
           {"keypoints", web::PointsFloat32Base64(v.keypoints)}, {"detected_keypoints", web::PointsFloat32Base64(v.detected_keypoints)}};
 }
@@ -276,6 +277,8 @@ std::string ViewsHtml(const std::vector<ReportView>& views) {
       << "<div class=\"legend\">"
       << "<span><label><input type=\"checkbox\" id=\"layer-input\" checked><span class=\"swatch\" "
          "style=\"background:#1f5fd6\"></span>input cloud</label></span>"
+      << "<span><label><input type=\"checkbox\" id=\"layer-outliers\" checked><span class=\"swatch\" "
+         "style=\"background:#e6194b\"></span>outliers (input points at &ge; &epsilon;<sub>oc</sub>)</label></span>"
       << "<span><label><input type=\"checkbox\" id=\"layer-posed\" checked><span class=\"swatch\" "
          "style=\"background:#2e8b57\"></span>posed model (red when rejected)</label></span>"
       << "<span><label><input type=\"checkbox\" id=\"layer-truth\"><span class=\"swatch\" "
@@ -353,6 +356,12 @@ std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Datas
       view.rotation_error = s->rotation_error;
       view.oc_distance = s->oc_distance;
       view.input = StridedColumns(cloud, options.max_points);
+      PointSet outliers(3, static_cast<Eigen::Index>(s->outlier_indices.size()));
+      Eigen::Index kept = 0;
+      for (int j : s->outlier_indices) {
+        if (j >= 0 && j < cloud.cols()) outliers.col(kept++) = cloud.col(j);
+      }
+      view.outliers = StridedColumns(outliers.leftCols(kept), options.max_points);
       const PointSet model = StridedColumns(object.sample(), options.max_points);
       view.posed_model = s->scene_from_model * model;
       const auto& truth = dataset.entries[s->index].pose;

@@ -23,6 +23,11 @@ struct CorrectorBenchmarkOptions {
   std::uint64_t seed = 0;
   int threads = 1;                     // 1 = honest per-cloud timings
   int max_clouds = 0;                  // 0 = all
+  // Issue 16: stray points added to every cloud (AddStrayPoints; this
+  // fraction of its points, seeded by `seed`), and the Hausdorff distance
+  // (posed model vs posed model, object units) under which a pose is correct.
+  double stray_fraction = 0.0;
+  double correct_hausdorff = 0.02;
   void Check() const;
 };
 
@@ -41,6 +46,15 @@ struct CorrectorBenchmarkRow {
   double median_corrector_cpu_ms = 0.0;  // correction only, the thread's CPU time
   double median_certify_ms = 0.0;        // certificates only
   double mean_iterations = 0.0;
+  // Certificates (oc_m and nd_m) against the Hausdorff distance to the truth.
+  double percent_certified = 0.0;
+  double percent_correct = 0.0;           // Hausdorff <= correct_hausdorff
+  double percent_correct_certified = 0.0; // of the correct poses, certified
+  int false_certificates = 0;             // certified and not correct
+  double max_certified_hausdorff = 0.0;
+  double median_hausdorff = 0.0;
+  double q05_nd_eigenvalue_correct = 0.0; // 5 % quantile of λ_min over correct poses
+  double percent_nd_local = 0.0;          // local non-degeneracy passed
 };
 
 // One cloud of one cell, with its input: lets another implementation rerun
@@ -55,6 +69,10 @@ struct CorrectorBenchmarkCase {
   int iterations = 0;
   double cost_before = 0.0, cost_after = 0.0;   // f(ỹ), f(y*); 0 for registration alone
   bool oc = false;
+  bool certified = false;
+  bool nd_local = false;
+  double hausdorff = 0.0;          // Hausdorff(T*·B̂, T̂·B̂)
+  double nd_eigenvalue = 0.0;
 };
 
 // Requires ground truth (pose + keypoints) in every entry. With `cases`, also

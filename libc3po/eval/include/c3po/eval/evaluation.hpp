@@ -74,6 +74,7 @@ struct SampleResult {
   bool oc = false;
   bool nd = false;
   double oc_distance = 0.0;            // max_x min_p ||x - p|| (evidence of oc)
+  std::vector<int> outlier_indices;    // input points at >= eps_oc (oc_m's outliers, ascending)
   double milliseconds = 0.0;           // estimation + certification time of this method
   bool ok() const { return error.empty(); }
   bool certified() const { return oc && nd; }

@@ -85,12 +85,6 @@ AutoEpsOcResult EstimateEpsOc(const ObjectModel& object, const std::vector<Point
                               const AutoEpsOcOptions& options,
                               const std::vector<double>* oc_distances = nullptr);
 
-// The oc decision from its evidence with another threshold (the distances do
-// not depend on eps_oc): lets `certify --eps-oc auto` decide after seeing every
-// cloud's oc distance.
-void RethresholdObservableCorrectness(ObservableCorrectness* oc, double eps_oc,
-                                      bool check_keypoint_agreement = true);
-
 // q in [0, 1]: linear interpolation between order statistics; 0 when empty.
 double SampleQuantile(std::vector<double> values, double q);
 

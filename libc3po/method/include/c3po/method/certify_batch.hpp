@@ -95,7 +95,16 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   cloud, R (3 rows), t, keypoints (N x 3, corrected), oc, nd, certified,
 //   oc_distance (null when not finite), keypoint_distance, nd_set,
 //   nd_set_distances, eps_oc, delta_nd, iterations, cost_before, cost_after
-//   (null when not finite), status (registration), ms.
+//   (null when not finite), status (registration), then the outlier-robust
+//   evidence (docs/method.md "Outlier-robust certificates"): max_outliers (m
+//   for this cloud), outliers (count at >= eps_oc), outlier_indices (the first
+//   kMaxListedOutliers, ascending), outlier_indices_truncated,
+//   distance_quantiles (50/90/99/100 %, null when not finite),
+//   max_inlier_distance, keypoint_support (per keypoint), nd_set_support (per
+//   set), nd_sets, nd_local (null when the local test is off),
+//   nd_local_eigenvalue, nd_local_motion (6: rotation, translation),
+//   nd_local_rank; and last ms.
+constexpr std::size_t kMaxListedOutliers = 100;
 std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& estimate);
 // {"cloud": ..., "error": ...} for a cloud that could not be processed.
 std::string CertifyErrorJsonLine(const std::string& cloud, const std::string& error);

@@ -27,10 +27,24 @@ enum class CorrectorSolver {
   kFast,             // pose-space ICP + damped point-to-plane steps (mean), IRLS (max); see above
   kGradientDescent,  // the reference: fixed step in keypoint space
 };
+// Robust kernel rho on the squared distance s = d^2 of each input point in the
+// mean loss, L_pc = (1/n) sum_j rho(d_j^2) (issue 16; method.md "Robust
+// corrector"), with scale c tied to eps_oc:
+//   none: rho(s) = s
+//   tls:  rho(s) = min(s, c^2)              (truncated least squares, TEASER++)
+//   gm:   rho(s) = c^2 s / (c^2 + s)        (Geman-McClure)
+// The fast solver minimises it by IRLS with weights w = rho'(s) and graduated
+// non-convexity (the scale starts at 8c and halves to c in the basin stage).
+enum class RobustLoss { kNone, kTruncated, kGemanMcClure };
 const char* ToString(PointCloudLoss loss);
 const char* ToString(CorrectorSolver solver);
+const char* ToString(RobustLoss loss);
 PointCloudLoss ParsePointCloudLoss(const std::string& text);    // "mean" | "max"
 CorrectorSolver ParseCorrectorSolver(const std::string& text);  // "fast" | "gd"
+RobustLoss ParseRobustLoss(const std::string& text);            // "none" | "tls" | "gm"
+// rho(s) and rho'(s) of the kernel at scale c (s = squared distance).
+double RobustRho(RobustLoss loss, double squared, double scale);
+double RobustWeight(RobustLoss loss, double squared, double scale);
 
 struct CorrectorOptions {
   double kappa = 10.0;
@@ -61,6 +75,10 @@ struct CorrectorOptions {
   // about three axes, and keep the lowest L_pc.
   double fast_restart_distance = -1.0;
   double fast_restart_angle = 0.8;
+  // Robust kernel of the mean loss (needs loss = mean); robust_scale is c in
+  // object units, -1 = the certified eps_oc (the object's unless overridden).
+  RobustLoss robust_loss = RobustLoss::kNone;
+  double robust_scale = -1.0;
   void Check() const;   // throws std::invalid_argument
 };
 
@@ -70,7 +88,8 @@ struct CorrectorResult {
   PointSet posed_keypoints;           // T(y*)·b
   double cost_before = 0.0;           // f(ỹ)
   double cost_after = 0.0;            // f(y*)
-  double point_cloud_loss = 0.0;      // L_pc(T(y*))
+  double point_cloud_loss = 0.0;      // L_pc(T(y*)) (robust kernel applied)
+  double robust_scale = 0.0;          // c used (0 without a robust kernel)
   double keypoint_loss = 0.0;         // L_kp(y*)
   int iterations = 0;
   bool converged = false;

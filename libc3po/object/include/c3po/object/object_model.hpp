@@ -54,6 +54,10 @@ class ObjectModel {
   const PointTree& tree() const { return *tree_; }
   // Unit outward normals of B̂ (of the triangle each sample point lies on).
   const PointSet& sample_normals() const { return *normals_; }
+  // 1 where a sample point lies at an edge or crease of the mesh (a neighbour
+  // among its 8 nearest has a normal > 30 degrees off): its normal does not
+  // represent nearby points (local non-degeneracy skips them).
+  const std::vector<char>& sample_on_crease() const { return *crease_; }
   double diameter() const { return diameter_; }
   // Mean nearest-neighbour spacing of B̂ (an estimate of the sampling density
   // term eps_s of Theorem 12).
@@ -73,8 +77,15 @@ class ObjectModel {
   Mesh mesh_;
   std::shared_ptr<const PointTree> tree_;
   std::shared_ptr<const PointSet> normals_;
+  std::shared_ptr<const std::vector<char>> crease_;
   double diameter_ = 0.0;
   mutable double spacing_ = -1.0;
 };
+
+// Hausdorff(T1·B̂, T2·B̂) = Hausdorff(B̂, T·B̂), T = T1^-1 T2, with a subsample
+// Q of B̂ as queries and the model tree as targets (no rebuild). A distance
+// between posed shapes: symmetries of the object cost nothing.
+double PosedModelHausdorff(const ObjectModel& object, const PointSet& queries, const Pose& first,
+                           const Pose& second);
 
 }  // namespace c3po

@@ -10,8 +10,10 @@
 //     inline SVG;
 //   - an interactive 3D view (three.js, the copy embedded for the annotation
 //     page; drag to orbit, wheel to zoom) of a few certified and a few
-//     rejected examples: input cloud, posed model sample, ground-truth posed
-//     model sample, detected and output keypoints.
+//     rejected examples: input cloud, its outliers under the estimate (points
+//     at >= eps_oc, which oc_m tolerates up to the budget m) in another
+//     colour, posed model sample, ground-truth posed model sample, detected
+//     and output keypoints.
 // Test hooks: document.body.dataset.ready = "1" once the page has set up,
 // window.c3poReport = {views (count), webgl (bool), shown (index), show(i),
 // frames (renders so far), orbit ({theta, phi, distance}), measure (set true
@@ -52,6 +54,7 @@ struct ReportView {
   double rotation_error = 0.0;  // radians
   double oc_distance = 0.0;
   PointSet input;               // the input cloud (subsampled)
+  PointSet outliers;            // its points at >= eps_oc from T̂·B̂ (subsampled)
   PointSet posed_model;         // T̂·B̂ (subsampled)
   PointSet truth_model;         // T*·B̂ (subsampled)
   PointSet keypoints;           // output keypoints
