@@ -5,7 +5,7 @@
 set -euo pipefail
 packages=(build-essential cmake ninja-build ccache
           libeigen3-dev libnanoflann-dev libcli11-dev nlohmann-json3-dev doctest-dev
-          libassimp-dev tiny-dnn)
+          libassimp-dev tiny-dnn libspng-dev libpng-dev pkg-config parallel)
 if [[ "${1:-}" != "--no-browser" ]]; then
   packages+=(chromium)
   # Node.js + npm run the browser tests (playwright-core from the npm registry);
