@@ -6,7 +6,8 @@ namespace c3po::cli {
 void SetupSynthBench(CLI::App& parent, std::function<int()>* run);
 void SetupPointNetBench(CLI::App& parent, std::function<int()>* run);
 void SetupMeshBench(CLI::App& parent, std::function<int()>* run);
+void SetupSegmentsBench(CLI::App& parent, std::function<int()>* run);
 
-std::vector<BenchEntry> BenchEntries() { return {{SetupSynthBench}, {SetupPointNetBench}, {SetupMeshBench}}; }
+std::vector<BenchEntry> BenchEntries() { return {{SetupSynthBench}, {SetupPointNetBench}, {SetupMeshBench}, {SetupSegmentsBench}}; }
 
 }  // namespace c3po::cli
