@@ -1,5 +1,7 @@
 #include "c3po/io/shard.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include "c3po/base/error.hpp"
 
 namespace c3po {
@@ -36,6 +38,38 @@ std::vector<std::size_t> ShardJobs(const std::vector<std::int64_t>& group_keys, 
     if (group[i] >= first && group[i] < last) jobs.push_back(i);
   }
   return jobs;
+}
+
+std::string MergeShardOutputs(const std::vector<std::pair<std::string, std::string>>& parts, bool csv) {
+  std::string merged, header;
+  for (const auto& [name, text] : parts) {
+    std::size_t start = 0, line_number = 0;
+    while (start < text.size()) {
+      std::size_t end = text.find('\n', start);
+      if (end == std::string::npos) end = text.size();
+      const std::string line = text.substr(start, end - start);
+      start = end + 1;
+      ++line_number;
+      if (csv && line_number == 1) {
+        if (line.rfind("scene_id,im_id,obj_id,score,R,t,time", 0) != 0) throw InputError(name, "line 1: not a BOP results CSV header");
+        if (header.empty()) {
+          header = line;
+          merged += line + "\n";
+        } else if (line != header) {
+          throw InputError(name, "line 1: header differs from the first part's");
+        }
+        continue;
+      }
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+      if (!csv) {
+        const nlohmann::json parsed = nlohmann::json::parse(line, nullptr, false);
+        if (!parsed.is_object()) throw InputError(name, "line " + std::to_string(line_number) + ": not a JSON object");
+      }
+      merged += line + "\n";
+    }
+    if (csv && line_number == 0) throw InputError(name, "empty (a BOP CSV part has at least its header)");
+  }
+  return merged;
 }
 
 }  // namespace c3po

@@ -25,4 +25,10 @@ Shard ParseShard(const std::string& text);
 // shard takes groups [floor((K-1) G / N), floor(K G / N)).
 std::vector<std::size_t> ShardJobs(const std::vector<std::int64_t>& group_keys, const Shard& shard);
 
+// Joins shard outputs given in shard order (name, contents): JSON lines are
+// concatenated (every non-empty line must be a JSON object); BOP CSVs
+// (`csv`) keep one header, which every part must have. Throws InputError
+// naming the part.
+std::string MergeShardOutputs(const std::vector<std::pair<std::string, std::string>>& parts, bool csv);
+
 }  // namespace c3po
