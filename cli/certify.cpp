@@ -69,6 +69,7 @@ struct CloudJob {
   std::optional<FrameInput> frame;              // --depth/--mask
   std::optional<BopInstance> bop;               // --bop
   std::int64_t group = 0;                       // --shard groups (a BOP image)
+  std::optional<SegmentCloud> preloaded;        // the --depth/--mask frame, read up front
 };
 
 struct CloudOutcome {
@@ -102,18 +103,30 @@ std::string InstanceName(const BopInstance& instance) {
 
 void CollectJobs(const CertifyCommand& cmd, Sources* sources) {
   std::vector<CloudJob>& jobs = sources->jobs;
-  for (const auto& path : cmd.clouds) jobs.push_back({path, path, std::nullopt, std::nullopt, std::nullopt, 0});
+  auto job_named = [](const std::string& name, const std::string& path) {
+    CloudJob job;
+    job.name = name;
+    job.path = path;
+    return job;
+  };
+  for (const auto& path : cmd.clouds) jobs.push_back(job_named(path, path));
   if (!cmd.data_dir.empty()) {
     const Dataset dataset = ReadDataset(cmd.data_dir, /*ground_truth=*/false);
     for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
       const DatasetEntry& entry = dataset.entries[i];
-      jobs.push_back({entry.cloud, dataset.CloudPath(i), entry.detected_keypoints, std::nullopt, std::nullopt, 0});
+      CloudJob job = job_named(entry.cloud, dataset.CloudPath(i));
+      job.manifest_keypoints = entry.detected_keypoints;
+      jobs.push_back(std::move(job));
     }
   }
   if (!cmd.depth_path.empty() || !cmd.mask_path.empty()) {
     if (cmd.depth_path.empty() || cmd.mask_path.empty()) throw InputError("c3po certify", "--depth and --mask go together");
+    // Read now: a bad depth, mask or camera stops the run before any output.
     FrameInput frame{cmd.depth_path, cmd.mask_path, cmd.label_id, CommandCamera(cmd)};
-    jobs.push_back({cmd.mask_path, cmd.mask_path, std::nullopt, frame, std::nullopt, 0});
+    CloudJob job = job_named(cmd.mask_path, cmd.mask_path);
+    job.frame = frame;
+    job.preloaded = LoadFrameSegment(frame, cmd.segment);
+    jobs.push_back(std::move(job));
   }
   if (!cmd.bop_dir.empty()) {
     BopOptions options;
@@ -124,8 +137,10 @@ void CollectJobs(const CertifyCommand& cmd, Sources* sources) {
     sources->bop = ListBopInstances(cmd.bop_dir, options);
     for (const BopInstance& instance : sources->bop.instances) {
       const std::string name = InstanceName(instance);
-      jobs.push_back({name, name, std::nullopt, std::nullopt, instance,
-                      static_cast<std::int64_t>(instance.scene_id) * 1000000000LL + instance.im_id});
+      CloudJob job = job_named(name, name);
+      job.bop = instance;
+      job.group = static_cast<std::int64_t>(instance.scene_id) * 1000000000LL + instance.im_id;
+      jobs.push_back(std::move(job));
     }
     if (sources->bop.instances.empty()) {
       throw InputError(cmd.bop_dir, "no instances of obj_id " + std::to_string(cmd.obj_id) +
@@ -325,7 +340,7 @@ int Run(const CertifyCommand& cmd) {
     try {
       PointSet cloud;
       if (job.frame || job.bop) {
-        SegmentCloud segment = job.frame ? LoadFrameSegment(*job.frame, cmd.segment) : LoadBopInstance(*job.bop, cmd.segment);
+        SegmentCloud segment = job.preloaded ? *job.preloaded : LoadBopInstance(*job.bop, cmd.segment);
         cloud = std::move(segment.cloud);
         segment.cloud.resize(3, 0);   // the counts stay for the output
         outcomes[i].segment = std::move(segment);

@@ -13,13 +13,14 @@
 #include <set>
 #include <sstream>
 
-#include "c3po/atomic_file.hpp"
-#include "c3po/bop.hpp"
-#include "c3po/error.hpp"
-#include "c3po/mesh.hpp"
-#include "c3po/object_io.hpp"
-#include "c3po/render.hpp"
-#include "c3po/rle.hpp"
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/io/bop.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/io/mesh_io.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/geometry/render.hpp"
+#include "c3po/io/rle.hpp"
 #include "test_helpers.hpp"
 
 namespace {

@@ -1,6 +1,8 @@
 // COCO RLE masks (rle.hpp).
 #include "c3po/io/rle.hpp"
 
+#include <cstdio>
+
 #include "c3po/base/error.hpp"
 
 namespace c3po {
@@ -15,7 +17,12 @@ RleCounts ParseRleString(const std::string& text, const std::string& name) {
     while (more) {
       if (p >= text.size()) throw InputError(name, "malformed RLE: string ends inside a run");
       const int c = static_cast<unsigned char>(text[p]) - 48;
-      if (c < 0 || c > 63) throw InputError(name, "malformed RLE: character '" + std::string(1, text[p]) + "' at " + std::to_string(p));
+      if (c < 0 || c > 63) {
+        char code[8];
+        std::snprintf(code, sizeof code, "0x%02x", static_cast<unsigned char>(text[p]));
+        throw InputError(name, std::string("malformed RLE: character ") + code + " at " + std::to_string(p) +
+                                   " (expected '0'..'o')");
+      }
       if (k >= 12) throw InputError(name, "malformed RLE: run too long at " + std::to_string(p));
       x |= static_cast<std::int64_t>(c & 0x1f) << (5 * k);
       more = (c & 0x20) != 0;
