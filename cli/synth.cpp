@@ -32,6 +32,7 @@ struct SynthCommand {
   std::string perturb_sigma;
   std::string perturb_fraction;
   std::uint64_t seed = 0;
+  std::string shard;
 };
 
 void Declare(CLI::App& command, SynthCommand& o) {
@@ -65,6 +66,7 @@ void Declare(CLI::App& command, SynthCommand& o) {
   command.add_option("--perturb-fraction", o.perturb_fraction,
                      "Probability that a keypoint is perturbed (default 0.8)");
   command.add_option("--seed", o.seed, "Seed (same seed, same bytes)")->capture_default_str();
+  command.add_option("--shard", o.shard, "Write part K of N (K/N) of the clouds under their global names; join with c3po merge");
 }
 
 // A non-negative distance: "0", "0.001", "1mm", "0.5%d".
@@ -110,6 +112,7 @@ SynthOptions MakeOptions(const SynthCommand& o, double diameter) {
     options.perturb_fraction = ParseNumber(o.perturb_fraction, "--perturb-fraction");
   }
   options.seed = o.seed;
+  if (!o.shard.empty()) options.shard = ParseShard(o.shard);
   options.Check();
   return options;
 }

@@ -366,6 +366,9 @@ TEST_CASE(".npy depth: C and Fortran order, float64, strict header and size") {
   std::string three = npy;
   three.replace(three.find("(2, 3)"), 6, "(2,3,1)");
   CHECK(ErrorOf([&] { c3po::ParseNpyDepth(three, "d.npy"); }).find("d.npy: .npy depth must have shape (H, W)") == 0);
+  std::string no_tuple = npy;   // found by fuzz_npy: an empty shape value
+  no_tuple.replace(no_tuple.find("(2, 3)"), 6, " ,(23)");
+  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(no_tuple, "d.npy"); }) == "d.npy: .npy header: shape must be a tuple (H, W)");
   DepthImage negative{1, 1, {-1.0f}};
   CHECK(ErrorOf([&] { c3po::ParseNpyDepth(c3po::EncodeNpyDepth(negative), "d.npy"); }) == "d.npy: negative or infinite depth in .npy");
 }

@@ -174,6 +174,9 @@ DepthImage ParseNpyDepth(const std::string& bytes, const std::string& name) {
   const std::string fortran = value_of("fortran_order");
   if (fortran != "False" && fortran != "True") throw InputError(name, ".npy header: fortran_order must be True or False");
   const std::string shape = value_of("shape");   // "(H, W)"
+  if (shape.size() < 2 || shape.front() != '(' || shape.back() != ')') {
+    throw InputError(name, ".npy header: shape must be a tuple (H, W)");
+  }
   std::vector<long long> dims;
   {
     std::string inner = shape.substr(1, shape.size() - 2);

@@ -44,6 +44,12 @@ DatasetEntry ParseManifestLine(const std::string& line, const std::string& where
 // Throws std::invalid_argument for non-finite values or mismatched sizes.
 std::string ManifestLine(const DatasetEntry& entry);
 
+// Joins dataset folders (e.g. the parts of `synth --shard K/N`, in order) into
+// `dir` through DatasetWriter: manifest lines in part order, clouds rewritten
+// as binary PLY under their names. Returns the number of clouds. Throws
+// InputError for unreadable parts or a cloud name in two parts.
+std::size_t MergeDatasets(const std::vector<std::string>& parts, const std::string& dir);
+
 // Writes a dataset into a hidden temporary sibling folder; Commit() renames it
 // to `dir` (replacing an existing dataset). Destroying an uncommitted writer
 // removes the temporary folder, so an interrupted run leaves no dataset.
