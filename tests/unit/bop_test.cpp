@@ -240,6 +240,11 @@ TEST_CASE("bad BOP folders: masks disagreeing with scene_gt.json, non-numbered s
         dir / "split/extras" + ": non-numbered scene folder in a BOP split (expected NNNNNN/)");
   fs::remove(dir / "split/extras");
   CHECK(c3po::ListBopInstances(dir / "split", options).instances.size() == 2);
+  // An image listing no instance (and without masks) is fine.
+  json gt_doc = json::parse(c3po::ReadFileToString(dir / "split/000001/scene_gt.json"));
+  gt_doc["7"] = json::array();
+  c3po::WriteFileAtomically(dir / "split/000001/scene_gt.json", gt_doc.dump());
+  CHECK(c3po::ListBopInstances(dir / "split", options).instances.size() == 2);
 
   const std::string gt = c3po::ReadFileToString(dir / "split/000001/scene_camera.json");
   json cameras = json::parse(gt);

@@ -123,8 +123,8 @@ void ListScene(const std::string& scene_dir, int scene_id, const BopOptions& opt
   for (const auto& [im_id, list] : gt) {
     const auto it = masks.find(im_id);
     const std::size_t files = it == masks.end() ? 0 : it->second.size();
-    const bool complete = it != masks.end() && files == list.size() &&
-                          *it->second.rbegin() == static_cast<int>(list.size()) - 1;
+    const bool complete = list.empty() ? files == 0
+                                       : files == list.size() && *it->second.rbegin() == static_cast<int>(list.size()) - 1;
     if (!complete) {
       throw InputError(gt_path, "image " + std::to_string(im_id) + " lists " + std::to_string(list.size()) +
                                     " instances but " + fs::path(mask_dir).filename().string() + "/ holds " +
@@ -228,10 +228,14 @@ std::vector<BopDetection> ParseDetections(const std::string& text, const std::st
     }
     // Checks the runs against the size now (a bad RLE fails the listing,
     // not a worker later), without keeping the decoded mask.
+    const std::int64_t pixels = static_cast<std::int64_t>(detection.height) * detection.width;
     std::int64_t sum = 0;
-    for (std::int64_t run : detection.counts) sum += std::min<std::int64_t>(run, std::int64_t{1} << 40);
-    if (sum != static_cast<std::int64_t>(detection.height) * detection.width) {
-      throw InputError(rle_name, "malformed RLE: runs cover " + std::to_string(sum) + " pixels, size " +
+    for (std::int64_t run : detection.counts) {
+      sum += std::min<std::int64_t>(run, pixels + 1);
+      if (sum > pixels) break;   // too many already (and no overflow)
+    }
+    if (sum != pixels) {
+      throw InputError(rle_name, "malformed RLE: runs cover " + std::string(sum > pixels ? "more than " + std::to_string(pixels) : std::to_string(sum)) + " pixels, size " +
                                      std::to_string(detection.height) + " x " + std::to_string(detection.width));
     }
     detections.push_back(std::move(detection));
