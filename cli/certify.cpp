@@ -1,4 +1,5 @@
-// c3po certify: detect -> correct -> certify every cloud (CertifyBatch); JSON
+// c3po certify: detect -> correct -> certify every cloud (CertifyBatch): point
+// clouds, dataset entries, a depth frame + mask or BOP instances; JSON
 // lines or a human table; exit 0 all certified, 1 some not certified, 2 input
 // error. Formatting only: the loop, `--eps-oc auto` and the JSON-lines schema
 // are the library's (c3po/method/certify_batch.hpp).
@@ -6,12 +7,16 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/io/bop.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/io/shard.hpp"
 #include "c3po/method/certify_batch.hpp"
+#include "c3po/method/image_sources.hpp"
 #include "c3po/object/object_io.hpp"
 #include "command.hpp"
 #include "options.hpp"
@@ -31,6 +36,12 @@ struct CertifyCommand {
   CorrectorFlags corrector;
   RobustFlags robust;
   bool no_correct = false;
+  // Images (one frame) and BOP datasets (docs/camera_inputs.md).
+  FrameFlags frame;
+  BopFlags bop;
+  SegmentOptions segment;
+  std::string bop_csv_path;
+  std::string shard;
 };
 
 std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
@@ -66,13 +77,32 @@ int Run(const CertifyCommand& cmd) {
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
   ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
   options.auto_eps_oc = cmd.thresholds.auto_eps_oc();
+  if (options.auto_eps_oc && !cmd.shard.empty()) {
+    throw InputError("--eps-oc", "auto estimates the threshold from all clouds of a run; with --shard give a value");
+  }
+  CheckSegmentOptions(cmd.segment, "c3po certify");
+  const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
 
   std::vector<CloudSource> sources = CloudFileSources(cmd.clouds);
-  if (!cmd.data_dir.empty()) {
-    const std::vector<CloudSource> entries = DatasetSources(ReadDataset(cmd.data_dir));
-    sources.insert(sources.end(), entries.begin(), entries.end());
+  const auto append = [&sources](const std::vector<CloudSource>& more) {
+    sources.insert(sources.end(), more.begin(), more.end());
+  };
+  // certify does not use ground truth: the manifest's is not even parsed.
+  if (!cmd.data_dir.empty()) append(DatasetSources(ReadDataset(cmd.data_dir, /*ground_truth=*/false)));
+  if (cmd.frame.given()) append(FrameSources(ResolveFrame(cmd.frame, "c3po certify"), cmd.segment));
+  if (!cmd.bop.dir.empty()) {
+    const BopInstances listed = ListBopInstances(cmd.bop.dir, cmd.bop.options);
+    if (listed.instances.empty()) {
+      throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id) +
+                                        (cmd.bop.options.detections_path.empty() ? "" : " in the detections") +
+                                        (cmd.bop.options.targets_path.empty() ? "" : " among the targets"));
+    }
+    append(BopSources(listed, cmd.segment));
   }
-  if (sources.empty()) throw InputError("c3po certify", "no clouds given (CLOUD... or --data DIR)");
+  if (sources.empty()) {
+    throw InputError("c3po certify", "no clouds given (CLOUD..., --data DIR, --depth/--mask or --bop DIR)");
+  }
+  if (shard) sources = ShardSources(sources, *shard);
   LoadPlugins(cmd.detector);
   const std::unique_ptr<Detector> detector =
       MakeDetector(cmd.detector.models.empty() ? "" : cmd.detector.models.front(),
@@ -95,12 +125,13 @@ int Run(const CertifyCommand& cmd) {
     const std::string& name = sources[i].name;
     if (!outcome.processed()) {
       std::cerr << "c3po certify: " << outcome.error << "\n";
-      if (cmd.json) json_lines << CertifyErrorJsonLine(name, outcome.error) << "\n";
+      if (cmd.json || !cmd.output_path.empty()) json_lines << CertifyJsonLine(sources[i], outcome) << "\n";
       continue;
     }
-    if (cmd.json || !cmd.output_path.empty()) json_lines << CertifyJsonLine(name, outcome.estimate) << "\n";
+    if (cmd.json || !cmd.output_path.empty()) json_lines << CertifyJsonLine(sources[i], outcome) << "\n";
     if (!cmd.json) std::cout << HumanLine(name, outcome) << "\n";
   }
+  if (!cmd.bop_csv_path.empty()) WriteFileAtomically(cmd.bop_csv_path, BopCsv(BopResultRows(sources, result)));
   if (!cmd.output_path.empty()) {
     WriteFileAtomically(cmd.output_path, json_lines.str());
   } else if (cmd.json) {
@@ -131,6 +162,12 @@ RunFunction SetupCertify(CLI::App& command) {
   command.add_flag("--no-correct", cmd->no_correct, "Certify the plain registration of the detected keypoints");
   AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);
+  AddFrameOptions(command, &cmd->frame);
+  AddBopOptions(command, &cmd->bop, BopDetections::kAllowed);
+  AddSegmentOptions(command, &cmd->segment);
+  command.add_option("--bop-csv", cmd->bop_csv_path,
+                     "Write BOP results CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm)");
+  AddShardOption(command, &cmd->shard, "clouds (by image for --bop, by cloud or manifest line otherwise)");
   return [cmd]() { return Run(*cmd); };
 }
 

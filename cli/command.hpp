@@ -20,5 +20,6 @@ RunFunction SetupCertify(CLI::App& command);
 RunFunction SetupEval(CLI::App& command);
 RunFunction SetupBench(CLI::App& command);
 RunFunction SetupDemo(CLI::App& command);
+RunFunction SetupMerge(CLI::App& command);
 
 }  // namespace c3po::cli

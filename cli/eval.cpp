@@ -6,7 +6,11 @@
 #include <iostream>
 #include <memory>
 
+#include <unistd.h>
+
 #include "c3po/base/atomic_file.hpp"
+#include "c3po/io/bop.hpp"
+#include "c3po/io/bop_dataset.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/eval/evaluation.hpp"
 #include "c3po/io/dataset.hpp"
@@ -42,7 +46,36 @@ struct EvalCommand {
   std::vector<std::string> training_logs;
   int views = 3;
   int worst = 5;
+  // BOP input (issue 15): converted to a temporary dataset.
+  BopFlags bop;
+  std::string models_info_path;
+  SegmentOptions segment;
 };
+
+// A temporary folder removed on destruction (the BOP instances as a dataset).
+class ScratchFolder {
+ public:
+  ScratchFolder() : path_((fs::temp_directory_path() / ("c3po_eval_bop." + std::to_string(::getpid()))).string()) {}
+  ~ScratchFolder() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// models_info.json for --bop: the option, else DIR/../models or DIR/../../models.
+std::string FindModelsInfo(const EvalCommand& cmd) {
+  if (!cmd.models_info_path.empty()) return cmd.models_info_path;
+  const fs::path dir = fs::absolute(cmd.bop.dir).lexically_normal();
+  for (const fs::path& candidate : {dir.parent_path() / "models/models_info.json",
+                                    dir.parent_path().parent_path() / "models/models_info.json"}) {
+    if (fs::exists(candidate)) return candidate.string();
+  }
+  return "";
+}
 
 // A detector to evaluate, owning what it loaded.
 struct LoadedDetector {
@@ -87,8 +120,7 @@ std::vector<LoadedDetector> LoadDetectors(const EvalCommand& cmd, const ObjectMo
   return detectors;
 }
 
-EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object) {
-  const double d = object.diameter();
+EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object, double d) {
   EvaluationOptions options = EvaluationOptions::Defaults(object);
   options.adds_threshold = ParseThreshold(cmd.adds_threshold, d, "--adds-threshold");
   options.auc_max = ParseThreshold(cmd.auc_max, d, "--auc-max");
@@ -150,7 +182,13 @@ std::vector<TrainingLog> ReadTrainingLogs(const EvalCommand& cmd, const std::vec
 }
 
 std::string CommandLine(const EvalCommand& cmd) {
-  std::string line = "c3po eval " + cmd.object_path + " --data " + cmd.data_dir;
+  std::string line = "c3po eval " + cmd.object_path;
+  if (cmd.bop.dir.empty()) {
+    line += " --data " + cmd.data_dir;
+  } else {
+    line += " --bop " + cmd.bop.dir + " --obj-id " + std::to_string(cmd.bop.options.obj_id);
+    if (!cmd.bop.options.targets_path.empty()) line += " --targets " + cmd.bop.options.targets_path;
+  }
   for (const auto& m : cmd.detector.models) line += " --model " + m;
   for (const auto& m : cmd.selftrained) line += " --selftrained " + m;
   for (const auto& d : cmd.detector.detectors) line += " --detector " + d;
@@ -164,9 +202,34 @@ std::string CommandLine(const EvalCommand& cmd) {
 
 int Run(const EvalCommand& cmd) {
   const ObjectModel object = LoadObject(cmd.object_path);
-  const EvaluationOptions options = MakeOptions(cmd, object);
+  if (cmd.data_dir.empty() == cmd.bop.dir.empty()) throw InputError("c3po eval", "give exactly one of --data DIR or --bop DIR");
+  // Fractions of d: the dataset's own diameter (models_info.json) when
+  // evaluating BOP data, else the object's bounding-box diagonal.
+  double diameter = object.diameter();
+  const std::string models_info = cmd.bop.dir.empty() ? "" : FindModelsInfo(cmd);
+  if (!models_info.empty()) {
+    const auto info = ParseModelsInfo(ReadFileToString(models_info), models_info);
+    const auto it = info.find(cmd.bop.options.obj_id);
+    if (it != info.end()) {
+      diameter = it->second.diameter_mm * kMetresPerMillimetre;
+      std::cerr << "c3po eval: d = " << diameter << " (diameter of obj_id " << cmd.bop.options.obj_id << " in " << models_info << ")\n";
+    }
+  }
+  const EvaluationOptions options = MakeOptions(cmd, object, diameter);
   if (cmd.views < 0) throw InputError("c3po eval", "--views must be >= 0");
-  const Dataset dataset = ReadDataset(cmd.data_dir);
+  ScratchFolder scratch;
+  std::string data_dir = cmd.data_dir;
+  if (!cmd.bop.dir.empty()) {
+    CheckSegmentOptions(cmd.segment, "c3po eval");
+    const BopInstances listed = ListBopInstances(cmd.bop.dir, cmd.bop.options);
+    if (listed.instances.empty()) throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id));
+    data_dir = scratch.path() + "/dataset";
+    const BopDatasetSummary summary = WriteDatasetFromBop(listed.instances, object.keypoints(), cmd.segment, data_dir);
+    for (const std::string& reason : summary.skipped) std::cerr << "c3po eval: skipped " << reason << "\n";
+    std::cerr << "c3po eval: " << summary.written << " BOP instances of obj_id " << cmd.bop.options.obj_id << " ("
+              << summary.skipped.size() << " skipped)\n";
+  }
+  const Dataset dataset = ReadDataset(data_dir);
   const std::vector<LoadedDetector> loaded = LoadDetectors(cmd, object);
   std::vector<EvaluatedDetector> detectors;
   for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});
@@ -209,7 +272,11 @@ int Run(const EvalCommand& cmd) {
 RunFunction SetupEval(CLI::App& command) {
   auto cmd = std::make_shared<EvalCommand>();
   command.add_option("object", cmd->object_path, "Object JSON")->required();
-  command.add_option("--data", cmd->data_dir, "Dataset folder with ground truth (manifest.jsonl + clouds)")->required();
+  command.add_option("--data", cmd->data_dir, "Dataset folder with ground truth (manifest.jsonl + clouds)");
+  AddBopOptions(command, &cmd->bop, BopDetections::kRefused);
+  command.add_option("--models-info", cmd->models_info_path,
+                     "BOP models_info.json (default: DIR/../models or DIR/../../models): its diameter is d");
+  AddSegmentOptions(command, &cmd->segment);
   AddDetectorOptions(command, &cmd->detector, DetectorCount::kMany);
   command.add_option("--selftrained", cmd->selftrained,
                      "Self-trained model file: C-3PO rows (also when a model header says \"selftrained\": true); repeatable")->allow_extra_args(false);

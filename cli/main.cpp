@@ -46,6 +46,8 @@ const std::vector<CommandEntry>& Commands() {
        c3po::cli::SetupEval},
       {"bench", "Measure speed and accuracy of components (prints figures)",
        "c3po bench corrector mug.json --data data/mug_depth", c3po::cli::SetupBench},
+      {"merge", "Join the outputs of --shard K/N runs (JSON lines or BOP CSV) in shard order",
+       "c3po merge -o poses.jsonl part1.jsonl part2.jsonl", c3po::cli::SetupMerge},
       {"demo", "Run the whole method on a bundled object (README's first command)",
        "c3po demo --out demo_out", c3po::cli::SetupDemo},
   };

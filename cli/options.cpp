@@ -3,8 +3,10 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <stdexcept>
 
 #include "c3po/base/error.hpp"
+#include "c3po/io/camera_io.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/registry.hpp"
 
@@ -126,6 +128,76 @@ void AddSeedOption(CLI::App& command, std::uint64_t* seed, const std::string& wh
 
 void AddThreadsOption(CLI::App& command, int* threads, const std::string& what) {
   command.add_option("--threads", *threads, "Worker threads (" + what + ")");
+}
+
+
+void AddSegmentOptions(CLI::App& command, SegmentOptions* options) {
+  command.add_option("--erode-mask", options->erode_mask, "Erode masks by K pixels (0 = off)")->capture_default_str();
+  command.add_option("--depth-edge", options->max_relative_depth_step,
+                     "Drop pixels whose depth differs from a neighbour's by more than this fraction of their "
+                     "depth (0 = off)")
+      ->capture_default_str();
+  command.add_option("--max-points", options->max_points,
+                     "At most this many points per image segment, evenly strided (0 = all)")
+      ->capture_default_str();
+}
+
+void CheckSegmentOptions(const SegmentOptions& options, const std::string& command) {
+  try {
+    options.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(command, e.what());
+  }
+}
+
+void AddFrameOptions(CLI::App& command, FrameFlags* flags) {
+  command.add_option("--depth", flags->depth_path,
+                     "Depth image: 16-bit PNG (value x depth_scale = mm) or .npy float metres");
+  command.add_option("--mask", flags->mask_path, "Mask PNG (8/16-bit; non-zero = object, or --label-id)");
+  command.add_option("--label-id", flags->label_id, "Mask is a label image: the object's pixels have this value");
+  command.add_option("--camera", flags->camera_path,
+                     "Camera JSON (cam_K row-major + depth_scale; BOP camera.json or scene_camera.json entry)");
+  command.add_option("--intrinsics", flags->intrinsics, "fx,fy,cx,cy (instead of --camera)");
+  command.add_option("--depth-scale", flags->depth_scale, "Millimetres per depth unit (overrides the camera file's)");
+}
+
+FrameInput ResolveFrame(const FrameFlags& flags, const std::string& command) {
+  if (flags.depth_path.empty() || flags.mask_path.empty()) throw InputError(command, "--depth and --mask go together");
+  FrameInput frame;
+  frame.depth_path = flags.depth_path;
+  frame.mask_path = flags.mask_path;
+  frame.label_id = flags.label_id;
+  if (!flags.camera_path.empty() && !flags.intrinsics.empty()) {
+    throw InputError(command, "give --camera FILE or --intrinsics fx,fy,cx,cy, not both");
+  }
+  if (!flags.camera_path.empty()) {
+    frame.camera = ReadCameraJson(flags.camera_path, flags.depth_scale);
+  } else if (flags.intrinsics.empty()) {
+    throw InputError(command, "--depth needs --camera FILE or --intrinsics fx,fy,cx,cy");
+  } else if (!flags.depth_scale) {
+    throw InputError(command, "--intrinsics needs --depth-scale S (mm per depth unit)");
+  } else {
+    frame.camera = CameraFromIntrinsics(flags.intrinsics, *flags.depth_scale);
+  }
+  return frame;
+}
+
+void AddBopOptions(CLI::App& command, BopFlags* flags, BopDetections detections) {
+  command.add_option("--bop", flags->dir, "BOP scene folder or split folder of numbered scenes");
+  command.add_option("--obj-id", flags->options.obj_id, "BOP object id (with --bop)");
+  command.add_option("--targets", flags->options.targets_path,
+                     "BOP targets JSON (test_targets_bop19.json): only these images");
+  if (detections == BopDetections::kAllowed) {
+    command.add_option("--detections", flags->options.detections_path,
+                       "BOP/COCO detections JSON (RLE masks) instead of ground-truth masks");
+    command.add_option("--min-score", flags->options.min_score, "Skip detections scoring below this")
+        ->capture_default_str();
+  }
+}
+
+void AddShardOption(CLI::App& command, std::string* shard, const std::string& what) {
+  command.add_option("--shard", *shard, "Process part K of N (K/N, 1-based) of the " + what +
+                                            ": disjoint, deterministic; join with c3po merge");
 }
 
 }  // namespace c3po::cli

@@ -9,9 +9,13 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "c3po/io/bop.hpp"
+#include "c3po/io/segment.hpp"
+#include "c3po/io/shard.hpp"
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"
 #include "c3po/method/detector.hpp"
@@ -78,6 +82,38 @@ void LoadPlugins(const DetectorFlags& flags);
 std::unique_ptr<Detector> MakeDetector(const std::string& model, const std::string& detector,
                                        const ObjectModel& object);
 constexpr const char* kManifestDetector = "manifest";
+
+// Camera inputs (docs/camera_inputs.md). --erode-mask, --depth-edge,
+// --max-points: the segment preprocessing (defaults: SegmentOptions).
+void AddSegmentOptions(CLI::App& command, SegmentOptions* options);
+// options->Check() as an InputError naming the command.
+void CheckSegmentOptions(const SegmentOptions& options, const std::string& command);
+
+// --depth, --mask, --label-id, --camera, --intrinsics, --depth-scale: one frame.
+struct FrameFlags {
+  std::string depth_path;
+  std::string mask_path;
+  int label_id = -1;
+  std::string camera_path;
+  std::string intrinsics;
+  std::optional<double> depth_scale;
+  bool given() const { return !depth_path.empty() || !mask_path.empty(); }
+};
+void AddFrameOptions(CLI::App& command, FrameFlags* flags);
+// The frame the flags name (reads the camera file). InputError when --depth
+// and --mask are not given together, or the camera is missing / given twice.
+FrameInput ResolveFrame(const FrameFlags& flags, const std::string& command);
+
+// --bop, --obj-id, --targets and (certify) --detections, --min-score.
+struct BopFlags {
+  std::string dir;
+  BopOptions options;
+};
+enum class BopDetections { kRefused, kAllowed };
+void AddBopOptions(CLI::App& command, BopFlags* flags, BopDetections detections);
+
+// --shard K/N ("" = the whole run); ParseShard (c3po/io/shard.hpp) resolves it.
+void AddShardOption(CLI::App& command, std::string* shard, const std::string& what);
 
 void AddSeedOption(CLI::App& command, std::uint64_t* seed, const std::string& what);
 void AddThreadsOption(CLI::App& command, int* threads, const std::string& what);

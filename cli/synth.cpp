@@ -36,6 +36,7 @@ struct SynthCommand {
   std::string perturb_fraction;
   std::uint64_t seed = 0;
   SynthBopCommand bop;
+  std::string shard;
 };
 
 void Declare(CLI::App& command, SynthCommand& o) {
@@ -74,13 +75,16 @@ void Declare(CLI::App& command, SynthCommand& o) {
                      "Probability that a keypoint is perturbed (default 0.8)");
   command.add_option("--seed", o.seed, "Seed (same seed, same bytes)")->capture_default_str();
   DeclareBopOptions(command, o.bop);
+  command.add_option("--shard", o.shard,
+                     "manifest: write part K of N (K/N) of the clouds under their global names; "
+                     "join with c3po merge");
 }
 
 // Options given on the command line that the chosen format does not use.
 void CheckFormatOptions(const CLI::App& command, const SynthCommand& o) {
   if (o.format == "bop") {
     for (const char* name : {"--kind", "--points", "--noise", "--dropout", "--perturb-sigma",
-                             "--perturb-fraction"}) {
+                             "--perturb-fraction", "--shard"}) {
       if (command.count(name) > 0) {
         throw InputError(name, "not used by --format bop (see --artefacts and docs/synth_bop.md)");
       }
@@ -138,6 +142,7 @@ SynthOptions MakeOptions(const SynthCommand& o, double diameter) {
     options.perturb_fraction = ParseNumber(o.perturb_fraction, "--perturb-fraction");
   }
   options.seed = o.seed;
+  if (!o.shard.empty()) options.shard = ParseShard(o.shard);
   options.Check();
   return options;
 }

@@ -54,4 +54,20 @@ grep -q -- "--eps-oc" eps.err || fail "eps error does not name the option"
 set +e; "$C3PO" certify "$OBJ" --detector manifest --data good --eps-oc 3%d -o out.jsonl > human.txt; set -e
 [ "$(wc -l < out.jsonl)" -eq 6 ] || fail "-o did not write 6 lines"
 grep -q "eps_oc = " human.txt || fail "human summary does not state eps_oc"
+# Ground truth certify does not use cannot stop it (issue 15): a manifest
+# whose "R" is clearly not a rotation is certified all the same; eval refuses it.
+mkdir -p badgt && cp good/000000.ply badgt/
+python3 - good/manifest.jsonl badgt/manifest.jsonl <<'PY'
+import json, sys
+line = json.loads(open(sys.argv[1]).readline())
+line['R'] = [[1, 0, 0], [0, 1, 0], [0, 0, 1.5]]
+open(sys.argv[2], 'w').write(json.dumps(line) + '\n')
+PY
+set +e
+"$C3PO" certify "$OBJ" --detector manifest --data badgt --json > badgt.jsonl 2> badgt.err; s_cert=$?
+"$C3PO" eval "$OBJ" --detector manifest --data badgt > /dev/null 2> badgt_eval.err; s_eval=$?
+set -e
+[ $s_cert -le 1 ] && [ "$(wc -l < badgt.jsonl)" -eq 1 ] || fail "certify refused a manifest for ground truth it does not use (exit $s_cert)"
+[ $s_eval -eq 2 ] && grep -q "not orthonormal" badgt_eval.err || fail "eval accepted a non-rotation (exit $s_eval)"
+
 echo "certify CLI: OK ($certified/6 certified with manifest keypoints)"

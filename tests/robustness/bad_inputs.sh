@@ -161,6 +161,68 @@ cp "$SRC/tests/fuzz/corpus/model/regression_magic_not_string" magic_object.model
 check model_magic_not_string "2" - magic_object.model magic_object.model -- "$C3PO" certify "$CUBE" --model magic_object.model sim/000000.ply
 fi
 
+# --- depth images, masks, cameras, BOP folders (issue 15) -------------------
+# PNGs written by a few lines of Python (zlib + struct), independent of c3po.
+python3 - <<'PY'
+import json, os, struct, zlib
+def png(path, w, h, depth=8, colour=0, value=lambda u, v: 0):
+    channels = 3 if colour == 2 else 1
+    size = depth // 8
+    rows = b''
+    for v in range(h):
+        rows += b'\0' + b''.join(int(value(u, v)).to_bytes(size, 'big') * channels for u in range(w))
+    def chunk(kind, data):
+        return struct.pack('>I', len(data)) + kind + data + struct.pack('>I', zlib.crc32(kind + data) & 0xffffffff)
+    with open(path, 'wb') as f:
+        f.write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, depth, colour, 0, 0, 0))
+                + chunk(b'IDAT', zlib.compress(rows)) + chunk(b'IEND', b''))
+box = lambda u, v: 255 if 2 <= u < 10 and 2 <= v < 8 else 0
+png('depth.png', 12, 10, 16, value=lambda u, v: 800 + u)
+png('mask.png', 12, 10, value=box)
+png('mask_small.png', 11, 10, value=box)
+png('depth_rgb.png', 12, 10, 8, 2, value=lambda u, v: 80)
+png('depth_8bit.png', 12, 10, 8, value=lambda u, v: 80)
+data = open('depth.png', 'rb').read()
+open('depth_truncated.png', 'wb').write(data[:len(data) // 2])
+K = [50.0, 0, 6, 0, 50.0, 5, 0, 0, 1]
+json.dump({'cam_K': K, 'depth_scale': 1.0}, open('camera.json', 'w'))
+json.dump({'depth_scale': 1.0}, open('camera_no_K.json', 'w'))
+json.dump({'cam_K': K, 'depth_scale': 0}, open('camera_scale0.json', 'w'))
+# A BOP split: scene 000001 with image 1, instances 0 (obj 1) and 1 (obj 2).
+def scene(root, masks=(0, 1)):
+    os.makedirs(root + '/depth', exist_ok=True)
+    os.makedirs(root + '/mask_visib', exist_ok=True)
+    png(root + '/depth/000001.png', 12, 10, 16, value=lambda u, v: 800 + u)
+    for g in masks:
+        png(root + '/mask_visib/000001_%06d.png' % g, 12, 10, value=box)
+    json.dump({'1': {'cam_K': K, 'depth_scale': 1.0}}, open(root + '/scene_camera.json', 'w'))
+    R = [1, 0, 0, 0, 1, 0, 0, 0, 1]
+    json.dump({'1': [{'obj_id': 1, 'cam_R_m2c': R, 'cam_t_m2c': [0, 0, 800]},
+                     {'obj_id': 2, 'cam_R_m2c': R, 'cam_t_m2c': [0, 0, 800]}]}, open(root + '/scene_gt.json', 'w'))
+scene('split_named/000001'); os.makedirs('split_named/extra', exist_ok=True)
+scene('split_missing_mask/000001', masks=(0,))
+scene('split_ok/000001')
+json.dump([{'scene_id': 1, 'image_id': 1, 'category_id': 1, 'score': 0.9, 'bbox': [0, 0, 1, 1],
+            'segmentation': {'size': [10, 12], 'counts': '0\x7f1'}}], open('detections_bad_rle.json', 'w'))
+json.dump([{'scene_id': 1, 'image_id': 1, 'category_id': 1, 'score': 0.9, 'bbox': [0, 0, 1, 1],
+            'segmentation': {'size': [10, 12], 'counts': [5, 200]}}], open('detections_rle_long.json', 'w'))
+PY
+FRAME=(--detector svd -o frame.jsonl)
+check depth_mask_sizes "2" frame.jsonl mask_small.png depth.png mask_small.png -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask_small.png --camera camera.json
+check rgb_png_as_depth "2" frame.jsonl depth_rgb.png depth_rgb.png -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth_rgb.png --mask mask.png --camera camera.json
+check 8bit_png_as_depth "2" frame.jsonl depth_8bit.png depth_8bit.png -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth_8bit.png --mask mask.png --camera camera.json
+check truncated_depth_png "2" frame.jsonl depth_truncated.png depth_truncated.png -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth_truncated.png --mask mask.png --camera camera.json
+check camera_missing_cam_K "2" frame.jsonl camera_no_K.json camera_no_K.json -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --camera camera_no_K.json
+check camera_depth_scale_0 "2" frame.jsonl camera_scale0.json camera_scale0.json -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --camera camera_scale0.json
+check intrinsics_depth_scale_neg "2" frame.jsonl depth-scale depth.png -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --intrinsics 50,50,6,5 --depth-scale -1
+BOP=(--detector svd --obj-id 1 -o bop.jsonl --bop-csv bop.csv)
+check bop_non_numbered_scene "2" bop.csv split_named/extra split_named -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop split_named
+check bop_gt_vs_mask_files "2" bop.csv scene_gt.json split_missing_mask -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop split_missing_mask
+check bop_malformed_rle "2" bop.jsonl detections_bad_rle.json split_ok detections_bad_rle.json -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop split_ok --detections detections_bad_rle.json
+check bop_rle_too_long "2" bop.jsonl detections_rle_long.json split_ok detections_rle_long.json -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop split_ok --detections detections_rle_long.json
+check bop_not_a_folder "2" bop.jsonl camera.json camera.json -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop camera.json
+check shard_out_of_range "2" bop.jsonl shard split_ok -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop split_ok --shard 5/4
+
 # --- outputs that cannot be written (ENOTDIR, see the note at the top) ------
 printf 'a regular file\n' > blocker
 check certify_output_unwritable "2" blocker/out.jsonl blocker sim -- "$C3PO" certify "$CUBE" --detector svd --data sim -o blocker/out.jsonl

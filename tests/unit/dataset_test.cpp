@@ -310,3 +310,25 @@ TEST_CASE("DatasetWriter into an unwritable place gives InputError and no output
   CHECK(Listing(dir.path()) == std::vector<std::string>{"file"});
   MESSAGE("unwritable folder simulated with a path under a regular file: " << message);
 }
+
+TEST_CASE("float32 / few-digit rotations (within 1e-4) are projected; certify-style reading skips ground truth") {
+  c3po::Rng rng(31);
+  const Eigen::Matrix3d R = rng.Rotation();
+  std::string rows;
+  for (int r = 0; r < 3; ++r) {
+    char buffer[128];
+    std::snprintf(buffer, sizeof buffer, "[%.5f,%.5f,%.5f]", R(r, 0), R(r, 1), R(r, 2));   // ~1e-5 off
+    rows += (r ? "," : "") + std::string(buffer);
+  }
+  const auto entry = c3po::ParseManifestLine("{\"cloud\":\"a.ply\",\"R\":[" + rows + "],\"t\":[0,0,1]}", "m");
+  REQUIRE(entry.pose.has_value());
+  CHECK((entry.pose->R.transpose() * entry.pose->R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-14);
+  CHECK((entry.pose->R - R).cwiseAbs().maxCoeff() < 2e-5);
+  // Clearly not a rotation: refused with the measured error, unless ground truth is not read.
+  const std::string bad = "{\"cloud\":\"a.ply\",\"R\":[[1,0,0],[0,1,0],[0,0,1.001]],\"t\":[0,0,0],\"keypoints\":[[0,0,0]]}";
+  CHECK(ParseError(bad) == "m.jsonl: line 4: R: not orthonormal (max |R^T R - I| = 0.002, tolerance 0.0001)");
+  const auto skipped = c3po::ParseManifestLine(bad, "m", /*ground_truth=*/false);
+  CHECK(!skipped.pose);
+  CHECK(!skipped.keypoints);
+  CHECK(skipped.cloud == "a.ply");
+}

@@ -16,13 +16,12 @@
 #include "c3po/base/json.hpp"
 #include "c3po/base/paths.hpp"
 #include "c3po/io/cloud_io.hpp"
+#include "c3po/geometry/rotation.hpp"
 
 namespace c3po {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr double kRotationTolerance = 1e-6;   // max |R^T R - I| accepted
-constexpr double kProjectAbove = 1e-12;       // below this R is kept bit-exact
 constexpr int kMaxJsonDepth = 16;
 
 // `text` with control characters replaced, so messages stay on one line.
@@ -116,15 +115,10 @@ class LineParser {
     if (!value->is_array() || value->size() != 3) Fail("R", "expected 3 rows of 3 numbers");
     Eigen::Matrix3d R;
     for (int r = 0; r < 3; ++r) R.row(r) = Triple((*value)[static_cast<std::size_t>(r)], "R", "row " + std::to_string(r) + ": ").transpose();
-    const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    if (error > kRotationTolerance) Fail("R", "not orthonormal (max |R^T R - I| = " + std::to_string(error) + ")");
-    if (R.determinant() < 0) Fail("R", "determinant is -1 (a reflection, not a rotation)");
-    if (error > kProjectAbove) {
-      // Nearest rotation in the Frobenius norm: U V^T of the SVD (det stays +1
-      // because R is within 1e-6 of a rotation).
-      const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
-      R = svd.matrixU() * svd.matrixV().transpose();
-    }
+    std::string problem;
+    const std::optional<Eigen::Matrix3d> rotation = NearestRotation(R, &problem);
+    if (!rotation) Fail("R", problem);
+    R = *rotation;
     return R;
   }
 
@@ -198,7 +192,7 @@ bool Dataset::HasGroundTruth() const {
          });
 }
 
-DatasetEntry ParseManifestLine(const std::string& line, const std::string& where) {
+DatasetEntry ParseManifestLine(const std::string& line, const std::string& where, bool ground_truth) {
   if (!NestingWithin(line, kMaxJsonDepth)) throw InputError(where + ": JSON nested too deeply");
   nlohmann::json object;
   try {
@@ -213,13 +207,15 @@ DatasetEntry ParseManifestLine(const std::string& line, const std::string& where
   const LineParser parser(object, where);
   DatasetEntry entry;
   entry.cloud = parser.Cloud();
-  const auto R = parser.Rotation();
-  const auto t = parser.Translation();
-  if (R.has_value() != t.has_value()) parser.Fail(R ? "t" : "R", "missing (\"R\" and \"t\" go together)");
-  if (R) entry.pose = Pose{*R, *t};
-  entry.keypoints = parser.Points("keypoints");
+  if (ground_truth) {
+    const auto R = parser.Rotation();
+    const auto t = parser.Translation();
+    if (R.has_value() != t.has_value()) parser.Fail(R ? "t" : "R", "missing (\"R\" and \"t\" go together)");
+    if (R) entry.pose = Pose{*R, *t};
+    entry.keypoints = parser.Points("keypoints");
+    entry.visible = parser.Visible();
+  }
   entry.detected_keypoints = parser.Points("detected_keypoints");
-  entry.visible = parser.Visible();
   KeypointCount(entry, where);
   return entry;
 }
@@ -245,7 +241,7 @@ std::string ManifestLine(const DatasetEntry& entry) {
   return line.dump();
 }
 
-Dataset ReadDataset(const std::string& dir_argument) {
+Dataset ReadDataset(const std::string& dir_argument, bool ground_truth) {
   const std::string dir = StripTrailingSlashes(dir_argument);
   std::error_code ec;
   const fs::file_status status = fs::status(dir, ec);
@@ -268,7 +264,7 @@ Dataset ReadDataset(const std::string& dir_argument) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     const std::string where = manifest + ": line " + std::to_string(line_number);
-    DatasetEntry entry = ParseManifestLine(line, where);
+    DatasetEntry entry = ParseManifestLine(line, where, ground_truth);
     const auto [count, field] = KeypointCount(entry, where);
     if (count > 0 && keypoints > 0 && count != keypoints) {
       throw InputError(where + ": " + field + ": " + std::to_string(count) + " keypoints, but line " +

@@ -59,4 +59,21 @@ void DatasetWriter::Commit() {
   committed_ = true;
 }
 
+std::size_t MergeDatasets(const std::vector<std::string>& parts, const std::string& dir) {
+  DatasetWriter writer(dir);
+  std::set<std::string> names;
+  std::size_t order = 0;
+  for (const std::string& part : parts) {
+    const Dataset dataset = ReadDataset(part);
+    for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
+      if (!names.insert(dataset.entries[i].cloud).second) {
+        throw InputError(part, "cloud " + dataset.entries[i].cloud + " is also in an earlier part");
+      }
+      writer.Add(order++, dataset.entries[i], dataset.LoadCloud(i));
+    }
+  }
+  writer.Commit();
+  return order;
+}
+
 }  // namespace c3po

@@ -3,6 +3,7 @@
 #include "c3po/method/certify_batch.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <exception>
 #include <stdexcept>
 
@@ -133,9 +134,22 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
     ThrowIfInterrupted();
     const CloudSource& source = sources[i];
     CloudOutcome& outcome = result.outcomes[i];
+    const auto start = std::chrono::steady_clock::now();
     PointSet cloud;
     try {
-      cloud = source.load();
+      if (source.load_segment) {
+        SegmentCloud segment = source.load_segment();
+        cloud = std::move(segment.cloud);
+        segment.cloud.resize(3, 0);   // the counts stay for the output
+        outcome.segment = std::move(segment);
+        if (cloud.cols() < kMinSegmentPoints) {
+          SegmentCloud counts = *outcome.segment;
+          counts.cloud = cloud;
+          RequireUsableSegment(counts, source.name);   // throws the reason
+        }
+      } else {
+        cloud = source.load();
+      }
     } catch (const Interrupted&) {
       throw;
     } catch (const std::exception& e) {
@@ -161,8 +175,12 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
         outcome.uncorrected = EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected);
       }
       outcome.estimate = EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline);
+      outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (visit) visit(static_cast<std::size_t>(i), cloud, &outcome);
       if (options.auto_eps_oc) clouds[i] = std::move(cloud);
+    }
+    if (outcome.seconds == 0.0) {
+      outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
     if (progress) progress(++done, sources.size());
   });

@@ -13,12 +13,43 @@ nlohmann::ordered_json FiniteOrNull(double value) {
   return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
 }
 
-}  // namespace
+nlohmann::ordered_json RotationJson(const Eigen::Matrix3d& R) {
+  return {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
+}
 
-std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& e) {
+// "cloud", then the provenance keys of image inputs.
+nlohmann::ordered_json SourceKeys(const CloudSource& source, const CloudOutcome& outcome) {
+  nlohmann::ordered_json line;
+  line["cloud"] = source.name;
+  if (source.provenance) {
+    const CloudProvenance& p = *source.provenance;
+    line["scene_id"] = p.scene_id;
+    line["im_id"] = p.im_id;
+    line["gt_id"] = p.gt_id;
+    line["obj_id"] = p.obj_id;
+    if (p.detection_score) line["detection_score"] = *p.detection_score;
+  }
+  if (outcome.segment) {
+    const SegmentCloud& s = *outcome.segment;
+    line["pixels"] = s.mask_pixels;
+    line["no_depth"] = s.no_depth;
+    line["removed_erosion"] = s.removed_by_erosion;
+    line["removed_discontinuity"] = s.removed_by_discontinuity;
+    line["removed_subsampling"] = s.removed_by_subsampling;
+    line["points"] = s.pixels.size();
+  }
+  if (source.provenance && source.scene_from_model_truth) {
+    const Pose& G = *source.scene_from_model_truth;
+    line["gt_R"] = RotationJson(G.R);
+    line["gt_t"] = {G.t(0), G.t(1), G.t(2)};
+  }
+  return line;
+}
+
+// The estimate keys, appended in the documented order.
+void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
+  nlohmann::ordered_json& line = *out;
   const Pose& T = e.scene_from_model;
-  nlohmann::ordered_json line;  // keys in the documented order, "cloud" first
-  line["cloud"] = cloud;
   SetPoseJson(T, &line);
   line["keypoints"] = PointsToJson(e.keypoints);
   line["oc"] = e.certificate.oc.passed;
@@ -54,6 +85,24 @@ std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& e) {
                              nd.local.motion(3), nd.local.motion(4), nd.local.motion(5)};
   line["nd_local_rank"] = nd.local.model_rank;
   line["ms"] = e.milliseconds;
+}
+
+}  // namespace
+
+std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& estimate) {
+  nlohmann::ordered_json line;  // keys in the documented order, "cloud" first
+  line["cloud"] = cloud;
+  AddEstimateKeys(estimate, &line);
+  return line.dump();
+}
+
+std::string CertifyJsonLine(const CloudSource& source, const CloudOutcome& outcome) {
+  nlohmann::ordered_json line = SourceKeys(source, outcome);
+  if (!outcome.processed()) {
+    line["error"] = outcome.error;
+  } else {
+    AddEstimateKeys(outcome.estimate, &line);
+  }
   return line.dump();
 }
 

@@ -28,6 +28,8 @@ Eigen::Vector2d NormalPair(Rng& rng) {
 
 void SynthOptions::Check() const {
   if (count < 1) throw InputError("--count: must be at least 1");
+  if (shard.count < 1 || shard.index < 1 || shard.index > shard.count) throw InputError("--shard: need 1 <= K <= N");
+  if (shard.count > count) throw InputError("--shard: more parts than clouds (--count)");
   if (points < 1 || points > 10000000) throw InputError("--points: must be in [1, 10000000]");
   if (!(noise >= 0.0) || !std::isfinite(noise)) throw InputError("--noise: must be a distance >= 0");
   if (!(dropout >= 0.0 && dropout < 1.0)) throw InputError("--dropout: must be in [0, 1)");

@@ -122,19 +122,22 @@ SynthReport WriteSynthDataset(const Mesh& mesh, const ObjectSpec& spec,
   DatasetWriter writer(dir);
   const int workers = std::max(1, DefaultThreadCount());
   auto renderers = MakeRenderers(generator, workers);
-  const std::size_t total = static_cast<std::size_t>(options.count);
+  const std::size_t count = static_cast<std::size_t>(options.count);
+  const std::size_t shards = static_cast<std::size_t>(options.shard.count);
+  const std::size_t first = static_cast<std::size_t>(options.shard.index - 1) * count / shards;
+  const std::size_t last = static_cast<std::size_t>(options.shard.index) * count / shards;
   const std::size_t batch = static_cast<std::size_t>(workers) * 32;
   StatsAccumulator accumulator;
   std::vector<SampleStats> stats(batch);
-  for (std::size_t begin = 0; begin < total; begin += batch) {
-    const std::size_t end = std::min(total, begin + batch);
+  for (std::size_t begin = first; begin < last; begin += batch) {
+    const std::size_t end = std::min(last, begin + batch);
     RunBatch(generator, begin, end, renderers, [&](std::size_t i, const SynthSample& sample) {
       stats[i - begin] = StatsOf(sample);
       writer.Add(i, EntryOf(sample, i), sample.cloud);   // thread-safe
     });
     ThrowIfInterrupted();
     for (std::size_t i = begin; i < end; ++i) accumulator.Add(stats[i - begin]);
-    if (progress) progress(end, total);
+    if (progress) progress(end - first, last - first);
   }
   writer.Commit();
   SynthReport report = accumulator.Report(generator);

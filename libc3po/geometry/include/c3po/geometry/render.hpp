@@ -13,24 +13,23 @@
 
 #include "c3po/base/random.hpp"
 #include "c3po/base/types.hpp"
+#include "c3po/geometry/camera.hpp"
 #include "c3po/geometry/mesh.hpp"
 
 namespace c3po {
 
-struct CameraIntrinsics {
-  double fx = 525.0;
-  double fy = 525.0;
-  double cx = 319.5;
-  double cy = 239.5;
+// A rendering camera: the pinhole model (camera.hpp's PinholeCamera, the one
+// home of K, back-projection and projection) plus an image size. Default: a
+// 640 x 480 Kinect-like camera (fx = fy = 525).
+struct CameraIntrinsics : PinholeCamera {
+  CameraIntrinsics() : PinholeCamera{525.0, 525.0, 319.5, 239.5} {}
   int width = 640;
   int height = 480;
   // Throws InputError("intrinsics: ...") on non-positive focal lengths or
   // sizes, sizes above 16384 or 50 megapixels, or non-finite values.
   void Check() const;
   // Direction (z = 1) of the ray through image point (u, v).
-  Eigen::Vector3d Ray(double u, double v) const {
-    return {(u - cx) / fx, (v - cy) / fy, 1.0};
-  }
+  Eigen::Vector3d Ray(double u, double v) const { return BackProject(u, v, 1.0); }
 };
 
 // Parses "fx,fy,cx,cy,w,h"; throws InputError("--intrinsics: ...").

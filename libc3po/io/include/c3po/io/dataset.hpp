@@ -32,10 +32,13 @@ struct Dataset {
 // Throws InputError("dir/manifest.jsonl: line 3: field: problem") for
 // malformed lines, inconsistent keypoint counts, missing cloud files or clouds
 // escaping the folder; "dir: no manifest.jsonl (not a c3po dataset)" when the
-// manifest is missing. "R" must be a rotation (orthonormal within 1e-6, det +1);
-// tiny float errors are projected away.
-Dataset ReadDataset(const std::string& dir);
-DatasetEntry ParseManifestLine(const std::string& line, const std::string& where);
+// manifest is missing. "R" must be a rotation (orthonormal within
+// kRotationTolerance = 1e-4, det +1, rotation.hpp); float errors are projected
+// onto SO(3). `ground_truth = false` skips (does not parse or check) "R", "t",
+// "keypoints" and "visible": for commands that do not use ground truth
+// (certify), which must not refuse a dataset for it.
+Dataset ReadDataset(const std::string& dir, bool ground_truth = true);
+DatasetEntry ParseManifestLine(const std::string& line, const std::string& where, bool ground_truth = true);
 // One JSON object, no newline; doubles printed so they read back exactly.
 // Throws std::invalid_argument for non-finite values or mismatched sizes.
 std::string ManifestLine(const DatasetEntry& entry);

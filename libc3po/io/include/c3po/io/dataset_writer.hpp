@@ -44,4 +44,10 @@ class DatasetWriter {
   bool committed_ = false;
 };
 
+// Joins dataset folders (e.g. the parts of `synth --shard K/N`, in order) into
+// `dir` through DatasetWriter: manifest lines in part order, clouds rewritten
+// as binary PLY under their names. Returns the number of clouds. Throws
+// InputError for unreadable parts or a cloud name in two parts.
+std::size_t MergeDatasets(const std::vector<std::string>& parts, const std::string& dir);
+
 }  // namespace c3po

@@ -10,6 +10,7 @@
 // known, given keypoints and the ground-truth pose. New kinds of input (depth
 // images, BOP scenes) are new CloudSource factories; the loop does not change.
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -17,12 +18,21 @@
 
 #include "c3po/base/types.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/io/segment.hpp"
 #include "c3po/method/auto_threshold.hpp"
 #include "c3po/method/detector.hpp"
 #include "c3po/method/pipeline.hpp"
 #include "c3po/object/object_model.hpp"
 
 namespace c3po {
+
+// Where an image-derived cloud came from (a BOP instance, docs/camera_inputs.md):
+// gt_id is the index in that image's scene_gt.json list, or the detection's
+// index in a detections file.
+struct CloudProvenance {
+  int scene_id = 0, im_id = 0, gt_id = 0, obj_id = 0;
+  std::optional<double> detection_score;   // masks from --detections
+};
 
 struct CloudSource {
   std::string name;                          // how outputs name the cloud (path, manifest entry)
@@ -31,6 +41,10 @@ struct CloudSource {
   std::function<PointSet()> load;            // reads the cloud; throws InputError naming the file
   std::optional<PointSet> given_keypoints;   // e.g. a manifest's detected_keypoints, 3 x N
   std::optional<Pose> scene_from_model_truth;   // ground truth, when known
+  // Image inputs (depth + mask): reads and back-projects the segment
+  // (segment.hpp); used instead of `load`, and the outcome keeps its counts.
+  std::function<SegmentCloud()> load_segment;
+  std::optional<CloudProvenance> provenance;   // BOP instances
 };
 
 // Cloud files given by path (named by their path).
@@ -65,6 +79,10 @@ struct CloudOutcome {
   PointSet detected_keypoints;        // ỹ (given or detected)
   PoseEstimate estimate;              // pipeline.correct as given
   std::optional<PoseEstimate> uncorrected;   // also_uncorrected: T(ỹ), certified
+  // Image inputs: the preprocessing counts (segment.hpp; `cloud` emptied),
+  // also when the segment was too small to use (failure kLoad).
+  std::optional<SegmentCloud> segment;
+  double seconds = 0.0;               // reading + preprocessing + detection + estimate
   bool processed() const { return failure == Failure::kNone; }
   bool certified() const { return processed() && estimate.certified(); }
 };
@@ -108,5 +126,11 @@ constexpr std::size_t kMaxListedOutliers = 100;
 std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& estimate);
 // {"cloud": ..., "error": ...} for a cloud that could not be processed.
 std::string CertifyErrorJsonLine(const std::string& cloud, const std::string& error);
+// The same for a batch outcome, with the provenance keys of image inputs
+// after "cloud" (docs/camera_inputs.md "JSON line keys"): scene_id, im_id,
+// gt_id, obj_id (detection_score), then pixels, no_depth, removed_erosion,
+// removed_discontinuity, removed_subsampling, points, then gt_R, gt_t (BOP
+// ground truth, metres); error lines carry them too.
+std::string CertifyJsonLine(const CloudSource& source, const CloudOutcome& outcome);
 
 }  // namespace c3po

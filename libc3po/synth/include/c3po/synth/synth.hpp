@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "c3po/base/random.hpp"
+#include "c3po/io/shard.hpp"
 #include "c3po/base/types.hpp"
 #include "c3po/geometry/mesh.hpp"
 #include "c3po/geometry/render.hpp"
@@ -82,6 +83,10 @@ struct SynthOptions {
   double visibility_tolerance = -1.0;   // object units; -1 = 1 % of d
   int max_attempts = 1000;       // depth: views drawn per cloud before giving up
   std::uint64_t seed = 0;
+  // --shard K/N: write only samples [floor((K-1) count / N), floor(K count / N))
+  // under their global names; `c3po merge` joins the parts into the dataset
+  // the unsharded run writes.
+  Shard shard;
   void Check() const;            // throws InputError("--flag: problem")
   int ResolvedMinPoints() const { return min_points >= 0 ? min_points : points / 2; }
 };

@@ -1,0 +1,55 @@
+// c3po merge: joins the outputs of `--shard K/N` runs, given in shard order,
+// into what the unsharded run writes (JSON lines, or a BOP CSV by extension).
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/io/dataset.hpp"
+#include "c3po/io/dataset_writer.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/io/shard.hpp"
+#include "command.hpp"
+
+namespace c3po::cli {
+namespace {
+
+struct MergeCommand {
+  std::vector<std::string> parts;
+  std::string output_path;
+};
+
+bool IsCsv(const std::string& path) { return path.size() >= 4 && path.compare(path.size() - 4, 4, ".csv") == 0; }
+
+int Run(const MergeCommand& cmd) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(cmd.parts.front(), ec)) {   // dataset folders (synth --shard)
+    const std::size_t clouds = MergeDatasets(cmd.parts, cmd.output_path);
+    std::printf("wrote %s: %zu clouds from %zu parts\n", cmd.output_path.c_str(), clouds, cmd.parts.size());
+    return 0;
+  }
+  const bool csv = IsCsv(cmd.output_path);
+  std::vector<std::pair<std::string, std::string>> parts;
+  for (const std::string& path : cmd.parts) {
+    if (IsCsv(path) != csv) throw InputError(path, csv ? "not a .csv part for a .csv output" : "a .csv part for a JSON-lines output");
+    parts.emplace_back(path, ReadFileToString(path));
+  }
+  WriteFileAtomically(cmd.output_path, MergeShardOutputs(parts, csv));
+  return 0;
+}
+
+}  // namespace
+
+RunFunction SetupMerge(CLI::App& command) {
+  auto cmd = std::make_shared<MergeCommand>();
+  command.add_option("parts", cmd->parts, "Outputs of --shard 1/N .. N/N, in that order (files, or synth's dataset folders)")->required();
+  command.add_option("-o,--output", cmd->output_path, "Merged file (.csv: BOP CSV, one header; else JSON lines) or dataset folder")->required();
+  command.footer("Example:\n  parallel c3po certify obj.json --bop DIR --obj-id 5 --detector svd -o part{}.jsonl --bop-csv part{}.csv "
+                 "--shard {}/4 ::: 1 2 3 4\n  c3po merge -o poses.jsonl part{1..4}.jsonl && c3po merge -o results.csv part{1..4}.csv\n"
+                 "  c3po synth obj.json -o sim_{} --kind sim --count 1000 --shard {}/4 ...; c3po merge -o sim sim_1 sim_2 sim_3 sim_4");
+  return [cmd]() { return Run(*cmd); };
+}
+
+}  // namespace c3po::cli

@@ -1,0 +1,81 @@
+#pragma once
+// One object instance in an image -> its point cloud (issue 15), with the
+// preprocessing that removes what real sensors add around a segment
+// (docs/camera_inputs.md gives the measurements behind the defaults):
+//  1. mask pixels without depth are skipped (counted);
+//  2. mask erosion by k pixels (square (2k+1)^2 structuring element; the
+//     image border does not erode) drops pixels bleeding onto the background;
+//  3. depth-discontinuity filter: a pixel is dropped when an 8-neighbour with
+//     depth differs from it by more than `max_relative_depth_step` x its depth
+//     ("flying pixels" interpolated across depth edges);
+//  4. a bounded point count: evenly strided pixels (StridedColumns order).
+// Every step's removed count is reported: mask_pixels = no_depth +
+// removed_by_erosion + removed_by_discontinuity + removed_by_subsampling +
+// cloud.cols().
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "c3po/geometry/camera.hpp"
+#include "c3po/io/camera_io.hpp"
+#include "c3po/io/png_io.hpp"
+#include "c3po/base/types.hpp"
+
+namespace c3po {
+
+// A binary mask (1 = object), row-major.
+struct Mask {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> inside;
+  bool at(int u, int v) const { return inside[static_cast<std::size_t>(v) * width + u] != 0; }
+  std::size_t Count() const;
+};
+
+// Non-zero pixels (label_id < 0) or pixels equal to label_id (a label image).
+Mask MaskFromImage(const Image& image, int label_id = -1);
+// Erodes by k pixels (see above); k = 0 returns the mask.
+Mask ErodeMask(const Mask& mask, int k);
+
+struct SegmentOptions {
+  int erode_mask = 4;                      // pixels; 0 = off
+  double max_relative_depth_step = 0.02;   // 0 = filter off
+  int max_points = 5000;                   // 0 = every point
+  void Check() const;                      // throws std::invalid_argument
+};
+
+struct SegmentCloud {
+  PointSet cloud;                          // camera frame, metres
+  std::vector<std::int32_t> pixels;        // pixel index (v * width + u) of each point
+  std::size_t mask_pixels = 0;
+  std::size_t no_depth = 0;                // mask pixels without a measurement
+  std::size_t removed_by_erosion = 0;      // with depth, removed by step 2
+  std::size_t removed_by_discontinuity = 0;
+  std::size_t removed_by_subsampling = 0;
+};
+
+// Back-projects the mask's pixels. Throws InputError("name: ...") when depth
+// and mask sizes differ; an empty result is not an error here (callers report
+// "no pixels"/"no valid depth").
+SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const PinholeCamera& camera,
+                            const SegmentOptions& options, const std::string& name);
+
+// Fewer points than this is not a segment to estimate a pose from.
+inline constexpr int kMinSegmentPoints = 3;
+// Throws InputError("name: mask has no pixels" / "no valid depth under the
+// mask (N pixels)" / "only K points left after preprocessing (...)") when the
+// segment has fewer than kMinSegmentPoints points.
+void RequireUsableSegment(const SegmentCloud& segment, const std::string& name);
+
+// One frame given by files: depth (16-bit PNG or .npy), mask PNG (non-zero,
+// or == label_id when label_id >= 0), camera.
+struct FrameInput {
+  std::string depth_path;
+  std::string mask_path;
+  int label_id = -1;
+  CameraInfo camera;
+};
+// Reads and back-projects it; InputError naming the file on bad input.
+SegmentCloud LoadFrameSegment(const FrameInput& frame, const SegmentOptions& options);
+
+}  // namespace c3po

@@ -1,0 +1,47 @@
+// BOP instances -> c3po dataset folder (bop_dataset.hpp).
+#include "c3po/io/bop_dataset.hpp"
+
+#include <cstdio>
+#include <mutex>
+
+#include "c3po/io/dataset.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/base/interrupt.hpp"
+#include "c3po/base/parallel.hpp"
+
+namespace c3po {
+
+BopDatasetSummary WriteDatasetFromBop(const std::vector<BopInstance>& instances, const PointSet& model_keypoints,
+                                  const SegmentOptions& options, const std::string& dir) {
+  for (const BopInstance& instance : instances) {
+    if (!instance.ground_truth) throw InputError(dir, "BOP instances without ground truth (detections) cannot make a dataset");
+  }
+  DatasetWriter writer(dir);
+  std::vector<std::string> skipped(instances.size());
+  ParallelFor(0, static_cast<int>(instances.size()), [&](int i) {
+    ThrowIfInterrupted();
+    const BopInstance& instance = instances[static_cast<std::size_t>(i)];
+    char name[64];
+    std::snprintf(name, sizeof name, "%06d_%06d_%06d", instance.scene_id, instance.im_id, instance.gt_id);
+    try {
+      const SegmentCloud segment = LoadBopInstance(instance, options);
+      RequireUsableSegment(segment, name);
+      DatasetEntry entry;
+      entry.cloud = std::string(name) + ".ply";
+      entry.pose = *instance.ground_truth;
+      entry.keypoints = *instance.ground_truth * model_keypoints;
+      writer.Add(static_cast<std::size_t>(i), entry, segment.cloud);
+    } catch (const InputError& e) {
+      skipped[static_cast<std::size_t>(i)] = e.what();
+    }
+  });
+  BopDatasetSummary summary;
+  for (const std::string& reason : skipped) {
+    if (reason.empty()) ++summary.written; else summary.skipped.push_back(reason);
+  }
+  if (summary.written == 0) throw InputError(dir, "no BOP instance had a usable segment");
+  writer.Commit();
+  return summary;
+}
+
+}  // namespace c3po

@@ -1,0 +1,247 @@
+// Camera JSON and depth images (camera_io.hpp).
+#include "c3po/io/camera_io.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
+
+namespace c3po {
+namespace {
+
+using nlohmann::json;
+
+json ParseJson(const std::string& text, const std::string& name) {
+  try {
+    return json::parse(text);
+  } catch (const json::exception& e) {
+    throw InputError(name, std::string("not valid JSON: ") + e.what());
+  }
+}
+
+double FiniteNumber(const json& value, const std::string& name, const std::string& field) {
+  if (!value.is_number()) throw InputError(name, field + ": expected a number");
+  const double number = value.get<double>();
+  if (!std::isfinite(number)) throw InputError(name, field + ": not a finite number");
+  return number;
+}
+
+CameraInfo CameraFromEntry(const json& entry, const std::string& name, const std::string& prefix,
+                           std::optional<double> depth_scale) {
+  if (!entry.is_object()) throw InputError(name, prefix + "expected a JSON object");
+  CameraInfo camera;
+  if (entry.contains("cam_K")) {
+    const json& k = entry["cam_K"];
+    if (!k.is_array() || k.size() != 9) throw InputError(name, prefix + "cam_K: expected 9 numbers (row-major 3x3)");
+    double m[9];
+    for (std::size_t i = 0; i < 9; ++i) m[i] = FiniteNumber(k[i], name, prefix + "cam_K");
+    if (m[1] != 0.0 || m[3] != 0.0 || m[6] != 0.0 || m[7] != 0.0 || m[8] != 1.0) {
+      throw InputError(name, prefix + "cam_K: expected [fx, 0, cx, 0, fy, cy, 0, 0, 1] (no skew)");
+    }
+    camera.K = {m[0], m[4], m[2], m[5]};
+  } else if (entry.contains("fx") || entry.contains("fy") || entry.contains("cx") || entry.contains("cy")) {
+    for (const char* key : {"fx", "fy", "cx", "cy"}) {
+      if (!entry.contains(key)) throw InputError(name, prefix + key + ": missing");
+    }
+    camera.K = {FiniteNumber(entry["fx"], name, prefix + "fx"), FiniteNumber(entry["fy"], name, prefix + "fy"),
+                FiniteNumber(entry["cx"], name, prefix + "cx"), FiniteNumber(entry["cy"], name, prefix + "cy")};
+  } else {
+    throw InputError(name, prefix + "cam_K: missing (nor fx, fy, cx, cy)");
+  }
+  if (depth_scale) {
+    camera.depth_scale = *depth_scale;
+  } else if (entry.contains("depth_scale")) {
+    camera.depth_scale = FiniteNumber(entry["depth_scale"], name, prefix + "depth_scale");
+  } else {
+    throw InputError(name, prefix + "depth_scale: missing (give --depth-scale S)");
+  }
+  CheckCamera(camera, name + (prefix.empty() ? "" : ": " + prefix.substr(0, prefix.size() - 2)));
+  return camera;
+}
+
+bool AllKeysNumbered(const json& doc) {
+  if (!doc.is_object() || doc.empty()) return false;
+  for (const auto& item : doc.items()) {
+    const std::string& key = item.key();
+    if (key.empty() || key.size() > 9 || key.find_first_not_of("0123456789") != std::string::npos) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void CheckCamera(const CameraInfo& camera, const std::string& where) {
+  if (!std::isfinite(camera.depth_scale) || camera.depth_scale <= 0.0) {
+    throw InputError(where, "depth_scale must be a positive number, not " + std::to_string(camera.depth_scale));
+  }
+  camera.K.Check(where);
+}
+
+CameraInfo ParseCameraJson(const std::string& text, const std::string& name, std::optional<double> depth_scale) {
+  const json doc = ParseJson(text, name);
+  if (AllKeysNumbered(doc)) {
+    if (doc.size() != 1) {
+      throw InputError(name, "a scene_camera.json of " + std::to_string(doc.size()) +
+                                 " images; give one camera (a single entry, or use --bop)");
+    }
+    const auto item = doc.items().begin();
+    return CameraFromEntry(item.value(), name, item.key() + ": ", depth_scale);
+  }
+  return CameraFromEntry(doc, name, "", depth_scale);
+}
+
+CameraInfo ReadCameraJson(const std::string& path, std::optional<double> depth_scale) {
+  return ParseCameraJson(ReadFileToString(path), path, depth_scale);
+}
+
+std::map<int, CameraInfo> ParseSceneCamera(const std::string& text, const std::string& name) {
+  const json doc = ParseJson(text, name);
+  if (!doc.is_object()) throw InputError(name, "expected an object keyed by image id");
+  std::map<int, CameraInfo> cameras;
+  for (const auto& item : doc.items()) {
+    const std::string& key = item.key();
+    if (key.empty() || key.size() > 9 || key.find_first_not_of("0123456789") != std::string::npos) {
+      throw InputError(name, "key '" + key.substr(0, 40) + "' is not an image id");
+    }
+    cameras[std::stoi(key)] = CameraFromEntry(item.value(), name, key + ": ", std::nullopt);
+  }
+  return cameras;
+}
+
+CameraInfo CameraFromIntrinsics(const std::string& fx_fy_cx_cy, double depth_scale) {
+  std::vector<double> values;
+  std::stringstream stream(fx_fy_cx_cy);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size()) {
+      throw InputError("--intrinsics", "'" + item + "' is not a number (expected fx,fy,cx,cy)");
+    }
+    values.push_back(value);
+  }
+  if (values.size() != 4) throw InputError("--intrinsics", "expected 4 numbers fx,fy,cx,cy");
+  CameraInfo camera{{values[0], values[1], values[2], values[3]}, depth_scale};
+  CheckCamera(camera, "--intrinsics/--depth-scale");
+  return camera;
+}
+
+DepthImage DepthFromPng(const Image& image, double depth_scale) {
+  DepthImage depth{image.width, image.height, std::vector<float>(image.pixels.size())};
+  const double metres_per_unit = depth_scale * kMetresPerMillimetre;
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    depth.z[i] = static_cast<float>(image.pixels[i] * metres_per_unit);
+  }
+  return depth;
+}
+
+DepthImage ParseNpyDepth(const std::string& bytes, const std::string& name) {
+  static const char kMagic[] = "\x93NUMPY";
+  if (bytes.size() < 10 || bytes.compare(0, 6, kMagic, 6) != 0) throw InputError(name, "not a .npy file (bad magic)");
+  const int major = static_cast<unsigned char>(bytes[6]);
+  std::size_t header_len = 0, offset = 0;
+  if (major == 1) {
+    header_len = static_cast<unsigned char>(bytes[8]) | (static_cast<std::size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+    offset = 10;
+  } else if (major == 2 || major == 3) {
+    if (bytes.size() < 12) throw InputError(name, "truncated .npy header");
+    for (int i = 0; i < 4; ++i) header_len |= static_cast<std::size_t>(static_cast<unsigned char>(bytes[8 + i])) << (8 * i);
+    offset = 12;
+  } else {
+    throw InputError(name, ".npy version " + std::to_string(major) + " is not supported");
+  }
+  if (header_len > 65536 || offset + header_len > bytes.size()) throw InputError(name, "truncated .npy header");
+  const std::string header = bytes.substr(offset, header_len);
+  auto value_of = [&](const std::string& key) -> std::string {
+    const std::size_t at = header.find("'" + key + "'");
+    if (at == std::string::npos) throw InputError(name, ".npy header: '" + key + "' missing");
+    std::size_t colon = header.find(':', at);
+    if (colon == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
+    std::size_t start = header.find_first_not_of(' ', colon + 1);
+    if (start == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
+    std::size_t end = header[start] == '(' ? header.find(')', start) : header.find_first_of(",}", start);
+    if (end == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
+    return header.substr(start, end - start + (header[start] == '(' ? 1 : 0));
+  };
+  const std::string descr = value_of("descr");
+  int item_size = 0;
+  if (descr == "'<f4'") item_size = 4;
+  else if (descr == "'<f8'") item_size = 8;
+  else throw InputError(name, ".npy dtype " + descr.substr(0, 20) + " is not float32/float64 little-endian ('<f4', '<f8')");
+  const std::string fortran = value_of("fortran_order");
+  if (fortran != "False" && fortran != "True") throw InputError(name, ".npy header: fortran_order must be True or False");
+  const std::string shape = value_of("shape");   // "(H, W)"
+  if (shape.size() < 2 || shape.front() != '(' || shape.back() != ')') {
+    throw InputError(name, ".npy header: shape must be a tuple (H, W)");
+  }
+  std::vector<long long> dims;
+  {
+    std::string inner = shape.substr(1, shape.size() - 2);
+    std::stringstream stream(inner);
+    std::string item;
+    while (std::getline(stream, item, ',')) {
+      const std::size_t first = item.find_first_not_of(' ');
+      if (first == std::string::npos) continue;   // trailing comma
+      item = item.substr(first, item.find_last_not_of(' ') - first + 1);
+      if (item.empty() || item.size() > 9 || item.find_first_not_of("0123456789") != std::string::npos) {
+        throw InputError(name, ".npy header: bad shape " + shape.substr(0, 40));
+      }
+      dims.push_back(std::stoll(item));
+    }
+  }
+  if (dims.size() != 2) throw InputError(name, ".npy depth must have shape (H, W), not " + shape.substr(0, 40));
+  if (dims[0] <= 0 || dims[1] <= 0) throw InputError(name, ".npy depth of zero size");
+  const std::size_t height = static_cast<std::size_t>(dims[0]), width = static_cast<std::size_t>(dims[1]);
+  if (width * height > kMaxImagePixels) throw InputError(name, ".npy depth larger than the image limit");
+  const std::size_t data_offset = offset + header_len;
+  const std::size_t expected = width * height * static_cast<std::size_t>(item_size);
+  if (bytes.size() - data_offset != expected) {
+    throw InputError(name, ".npy data holds " + std::to_string(bytes.size() - data_offset) + " bytes, shape needs " +
+                               std::to_string(expected));
+  }
+  DepthImage depth{static_cast<int>(width), static_cast<int>(height), std::vector<float>(width * height)};
+  const char* data = bytes.data() + data_offset;
+  const bool column_major = fortran == "True";
+  for (std::size_t i = 0; i < width * height; ++i) {
+    double value;
+    if (item_size == 4) {
+      float f;
+      std::memcpy(&f, data + 4 * i, 4);
+      value = f;
+    } else {
+      std::memcpy(&value, data + 8 * i, 8);
+    }
+    if (std::isinf(value) || value < 0.0) throw InputError(name, "negative or infinite depth in .npy");
+    if (std::isnan(value)) value = 0.0;
+    const std::size_t target = column_major ? (i % height) * width + i / height : i;
+    depth.z[target] = static_cast<float>(value);
+  }
+  return depth;
+}
+
+DepthImage ReadDepth(const std::string& path, double depth_scale) {
+  const std::size_t dot = path.rfind('.');
+  const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  if (ext == ".npy" || ext == ".NPY") return ParseNpyDepth(ReadFileToString(path), path);
+  return DepthFromPng(ReadDepthPng(path), depth_scale);
+}
+
+std::string EncodeNpyDepth(const DepthImage& depth) {
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(depth.height) + ", " +
+                       std::to_string(depth.width) + "), }";
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string out("\x93NUMPY\x01\x00", 8);
+  out += static_cast<char>(header.size() & 0xff);
+  out += static_cast<char>(header.size() >> 8);
+  out += header;
+  const std::size_t start = out.size();
+  out.resize(start + 4 * depth.z.size());
+  std::memcpy(&out[start], depth.z.data(), 4 * depth.z.size());
+  return out;
+}
+
+}  // namespace c3po

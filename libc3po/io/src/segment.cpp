@@ -1,0 +1,148 @@
+// Mask -> point cloud with preprocessing (segment.hpp).
+#include "c3po/io/segment.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "c3po/base/error.hpp"
+
+namespace c3po {
+
+std::size_t Mask::Count() const {
+  return static_cast<std::size_t>(std::count_if(inside.begin(), inside.end(), [](std::uint8_t m) { return m != 0; }));
+}
+
+Mask MaskFromImage(const Image& image, int label_id) {
+  Mask mask{image.width, image.height, std::vector<std::uint8_t>(image.pixels.size())};
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    mask.inside[i] = label_id < 0 ? image.pixels[i] != 0 : image.pixels[i] == label_id;
+  }
+  return mask;
+}
+
+Mask ErodeMask(const Mask& mask, int k) {
+  if (k < 0) throw std::invalid_argument("ErodeMask: negative k");
+  if (k == 0) return mask;
+  // Separable: a pixel survives when its row window and then its column
+  // window of half-width k (clipped at the border) are all inside.
+  const int w = mask.width, h = mask.height;
+  std::vector<std::uint8_t> rows(mask.inside.size());
+  for (int v = 0; v < h; ++v) {
+    const std::uint8_t* in = mask.inside.data() + static_cast<std::size_t>(v) * w;
+    // outside[u] prefix counts of pixels not in the mask
+    std::vector<int> prefix(static_cast<std::size_t>(w) + 1, 0);
+    for (int u = 0; u < w; ++u) prefix[u + 1] = prefix[u] + (in[u] == 0);
+    for (int u = 0; u < w; ++u) {
+      const int lo = std::max(0, u - k), hi = std::min(w - 1, u + k);
+      rows[static_cast<std::size_t>(v) * w + u] = prefix[hi + 1] - prefix[lo] == 0;
+    }
+  }
+  Mask out{w, h, std::vector<std::uint8_t>(mask.inside.size())};
+  std::vector<int> prefix(static_cast<std::size_t>(h) + 1);
+  for (int u = 0; u < w; ++u) {
+    prefix[0] = 0;
+    for (int v = 0; v < h; ++v) prefix[v + 1] = prefix[v] + (rows[static_cast<std::size_t>(v) * w + u] == 0);
+    for (int v = 0; v < h; ++v) {
+      const int lo = std::max(0, v - k), hi = std::min(h - 1, v + k);
+      out.inside[static_cast<std::size_t>(v) * w + u] = prefix[hi + 1] - prefix[lo] == 0;
+    }
+  }
+  return out;
+}
+
+void SegmentOptions::Check() const {
+  if (erode_mask < 0 || erode_mask > 1000) throw std::invalid_argument("erode_mask must be in [0, 1000]");
+  if (!(max_relative_depth_step >= 0.0) || !std::isfinite(max_relative_depth_step)) {
+    throw std::invalid_argument("max_relative_depth_step must be >= 0");
+  }
+  if (max_points < 0) throw std::invalid_argument("max_points must be >= 0");
+}
+
+namespace {
+
+// Step 3: does an 8-neighbour with depth differ by more than step x z?
+bool OnDepthDiscontinuity(const DepthImage& depth, int u, int v, double step) {
+  const double z = depth.at(u, v);
+  const double limit = step * z;
+  for (int dv = -1; dv <= 1; ++dv) {
+    for (int du = -1; du <= 1; ++du) {
+      const int nu = u + du, nv = v + dv;
+      if ((du == 0 && dv == 0) || nu < 0 || nv < 0 || nu >= depth.width || nv >= depth.height) continue;
+      const float zn = depth.at(nu, nv);
+      if (DepthImage::Valid(zn) && std::abs(zn - z) > limit) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const PinholeCamera& camera,
+                            const SegmentOptions& options, const std::string& name) {
+  options.Check();
+  if (depth.width != mask.width || depth.height != mask.height) {
+    throw InputError(name, "depth is " + std::to_string(depth.width) + " x " + std::to_string(depth.height) +
+                               " but the mask is " + std::to_string(mask.width) + " x " + std::to_string(mask.height));
+  }
+  SegmentCloud result;
+  const Mask eroded = ErodeMask(mask, options.erode_mask);
+  std::vector<Eigen::Vector3d> kept;
+  std::vector<std::int32_t> kept_pixels;
+  for (int v = 0; v < mask.height; ++v) {
+    for (int u = 0; u < mask.width; ++u) {
+      if (!mask.at(u, v)) continue;
+      ++result.mask_pixels;
+      const float z = depth.at(u, v);
+      if (!DepthImage::Valid(z)) {
+        ++result.no_depth;
+      } else if (!eroded.at(u, v)) {
+        ++result.removed_by_erosion;
+      } else if (options.max_relative_depth_step > 0.0 &&
+                 OnDepthDiscontinuity(depth, u, v, options.max_relative_depth_step)) {
+        ++result.removed_by_discontinuity;
+      } else {
+        kept.push_back(camera.BackProject(u, v, z));
+        kept_pixels.push_back(v * mask.width + u);
+      }
+    }
+  }
+  PointSet all(3, static_cast<Eigen::Index>(kept.size()));
+  for (std::size_t i = 0; i < kept.size(); ++i) all.col(static_cast<Eigen::Index>(i)) = kept[i];
+  result.cloud = StridedColumns(all, options.max_points);
+  // The same columns as StridedColumns: floor(j n / k).
+  const std::size_t n = kept.size(), k = static_cast<std::size_t>(result.cloud.cols());
+  result.pixels.resize(k);
+  for (std::size_t j = 0; j < k; ++j) result.pixels[j] = kept_pixels[k == n ? j : j * n / k];
+  result.removed_by_subsampling = kept.size() - static_cast<std::size_t>(result.cloud.cols());
+  return result;
+}
+
+}  // namespace c3po
+
+namespace c3po {
+
+void RequireUsableSegment(const SegmentCloud& segment, const std::string& name) {
+  if (segment.cloud.cols() >= kMinSegmentPoints) return;
+  if (segment.mask_pixels == 0) throw InputError(name, "mask has no pixels");
+  if (segment.no_depth == segment.mask_pixels) {
+    throw InputError(name, "no valid depth under the mask (" + std::to_string(segment.mask_pixels) + " pixels)");
+  }
+  throw InputError(name, "only " + std::to_string(segment.cloud.cols()) + " points left after preprocessing (" +
+                             std::to_string(segment.mask_pixels) + " mask pixels, " + std::to_string(segment.no_depth) +
+                             " without depth, " + std::to_string(segment.removed_by_erosion) + " eroded, " +
+                             std::to_string(segment.removed_by_discontinuity) + " on depth edges)");
+}
+
+SegmentCloud LoadFrameSegment(const FrameInput& frame, const SegmentOptions& options) {
+  const DepthImage depth = ReadDepth(frame.depth_path, frame.camera.depth_scale);
+  const Mask mask = MaskFromImage(ReadPng(frame.mask_path), frame.label_id);
+  if (depth.width != mask.width || depth.height != mask.height) {
+    throw InputError(frame.mask_path, "mask is " + std::to_string(mask.width) + " x " + std::to_string(mask.height) +
+                                          " but the depth image " + frame.depth_path + " is " +
+                                          std::to_string(depth.width) + " x " + std::to_string(depth.height));
+  }
+  return ExtractSegment(depth, mask, frame.camera.K, options, frame.mask_path);
+}
+
+}  // namespace c3po

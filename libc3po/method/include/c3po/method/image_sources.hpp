@@ -1,0 +1,30 @@
+#pragma once
+// Image inputs as CloudSources of the one batch path (certify_batch.hpp;
+// issue 15, docs/camera_inputs.md): a depth frame + mask, BOP instances with
+// their ids and ground truth, --shard by image, and the BOP results rows of a
+// batch.
+#include <vector>
+
+#include "c3po/io/bop.hpp"
+#include "c3po/io/segment.hpp"
+#include "c3po/io/shard.hpp"
+#include "c3po/method/certify_batch.hpp"
+
+namespace c3po {
+
+// One frame given by files:
+// read and preprocessed now, so a bad depth, mask or camera is an InputError
+// before any output; named by the mask path.
+std::vector<CloudSource> FrameSources(const FrameInput& frame, const SegmentOptions& options);
+// Every listed BOP instance (named SSSSSS/IIIIII_GGGGGG), read when certified,
+// with its provenance and, from scene_gt.json, its ground truth.
+std::vector<CloudSource> BopSources(const BopInstances& instances, const SegmentOptions& options);
+// --shard K/N (shard.hpp): a BOP image's instances form one group, any other
+// source is a group of its own; parts 1..N concatenated are `sources`.
+std::vector<CloudSource> ShardSources(const std::vector<CloudSource>& sources, const Shard& shard);
+// BOP results rows (bop.hpp) from a batch: one per BOP source whose
+// registration succeeded; score = CertificateScore with the batch's eps_oc;
+// time = the seconds of all the object's sources of that image.
+std::vector<BopResultRow> BopResultRows(const std::vector<CloudSource>& sources, const CertifyBatchResult& result);
+
+}  // namespace c3po

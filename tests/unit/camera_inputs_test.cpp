@@ -1,0 +1,411 @@
+// Camera inputs (issue 15): back-projection against analytic surfaces and the
+// renderer's own points, depth_scale and .npy depth, masks, erosion and the
+// depth-discontinuity filter against brute force, COCO RLE against brute
+// force, camera JSON forms and errors, sharding.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "c3po/base/atomic_file.hpp"
+#include "c3po/io/camera_io.hpp"
+#include "c3po/base/error.hpp"
+#include "c3po/geometry/mesh.hpp"
+#include "c3po/object/object_io.hpp"
+#include "c3po/geometry/render.hpp"
+#include "c3po/io/rle.hpp"
+#include "c3po/io/segment.hpp"
+#include "c3po/io/shard.hpp"
+#include "test_helpers.hpp"
+
+namespace {
+
+using c3po::DepthImage;
+using c3po::Mask;
+
+const c3po::PinholeCamera kCamera{600.0, 610.0, 159.5, 121.0};
+
+template <typename F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const c3po::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+Mask FullMask(int w, int h) { return Mask{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h, 1)}; }
+
+c3po::SegmentOptions NoPreprocessing() {
+  c3po::SegmentOptions options;
+  options.erode_mask = 0;
+  options.max_relative_depth_step = 0.0;
+  options.max_points = 0;
+  return options;
+}
+
+// Depth of the sphere |X - c| = r along the ray of pixel (u, v) (0 = miss).
+double SphereDepth(const c3po::PinholeCamera& K, int u, int v, const Eigen::Vector3d& c, double r) {
+  const Eigen::Vector3d d((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0);   // X = z d
+  const double a = d.squaredNorm(), b = -2.0 * d.dot(c), cc = c.squaredNorm() - r * r;
+  const double disc = b * b - 4 * a * cc;
+  if (disc < 0) return 0.0;
+  return (-b - std::sqrt(disc)) / (2 * a);
+}
+
+Mask RandomMask(int w, int h, unsigned seed, double p) {
+  std::mt19937 rng(seed);
+  std::bernoulli_distribution on(p);
+  Mask mask{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h)};
+  for (auto& m : mask.inside) m = on(rng);
+  return mask;
+}
+
+}  // namespace
+
+TEST_CASE("back-projection: a tilted plane and a sphere, exact in float and within quantisation in 16-bit PNG") {
+  const int w = 320, h = 240;
+  // Plane n.X = 0.8 (n unit, tilted): z = 0.8 / (n . ray).
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  DepthImage plane{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      plane.z[static_cast<std::size_t>(v) * w + u] =
+          static_cast<float>(0.8 / n.dot(Eigen::Vector3d((u - kCamera.cx) / kCamera.fx, (v - kCamera.cy) / kCamera.fy, 1.0)));
+    }
+  }
+  const c3po::SegmentCloud flat = c3po::ExtractSegment(plane, FullMask(w, h), kCamera, NoPreprocessing(), "plane");
+  REQUIRE(flat.cloud.cols() == w * h);
+  CHECK(((n.transpose() * flat.cloud).array() - 0.8).abs().maxCoeff() < 1e-6);   // float32 depth
+  // Each point projects back onto its own pixel centre.
+  for (Eigen::Index i = 0; i < flat.cloud.cols(); i += 997) {
+    const Eigen::Vector2d uv = kCamera.Project(flat.cloud.col(i));
+    CHECK(uv.x() == doctest::Approx(flat.pixels[static_cast<std::size_t>(i)] % w).epsilon(1e-9));
+    CHECK(uv.y() == doctest::Approx(flat.pixels[static_cast<std::size_t>(i)] / w).epsilon(1e-9));
+  }
+
+  // Sphere through a 16-bit PNG: value = round(z_mm / depth_scale).
+  const Eigen::Vector3d centre(0.02, -0.01, 0.7);
+  const double radius = 0.12;
+  for (double depth_scale : {1.0, 0.1}) {
+    c3po::Image png(w, h, 16);
+    Mask mask{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h)};
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        const double z = SphereDepth(kCamera, u, v, centre, radius);
+        png.at(u, v) = static_cast<std::uint16_t>(std::lround(z * 1000.0 / depth_scale));
+        mask.inside[static_cast<std::size_t>(v) * w + u] = z > 0;
+      }
+    }
+    c3po::test::TempDir dir("backproject_sphere");
+    c3po::WritePng(dir / "d.png", png);
+    const DepthImage depth = c3po::ReadDepth(dir / "d.png", depth_scale);
+    const c3po::SegmentCloud sphere = c3po::ExtractSegment(depth, mask, kCamera, NoPreprocessing(), "sphere");
+    CHECK(sphere.cloud.cols() == static_cast<Eigen::Index>(mask.Count()));
+    CHECK(sphere.no_depth == 0);
+    // Quantisation: |dz| <= depth_scale/2 mm, moving the point along its ray
+    // (|ray| <= 1.1 here) changes |X - c| by at most that much.
+    const double tolerance = 1.1 * 0.5 * depth_scale * 1e-3 + 1e-6;
+    const double worst = ((sphere.cloud.colwise() - centre).colwise().norm().array() - radius).abs().maxCoeff();
+    CHECK(worst <= tolerance);
+    CHECK(worst > 0.0);
+  }
+}
+
+TEST_CASE("back-projection of a rendered object equals the renderer's own points") {
+  const c3po::ObjectModel object = c3po::LoadObject(c3po::test::SourceDir() + "/annotations/drill.json");
+  c3po::CameraIntrinsics intrinsics;   // 640 x 480, f = 525
+  c3po::DepthRenderer renderer(intrinsics);
+  c3po::Rng rng(5);
+  const c3po::Pose camera_from_model{rng.Rotation(), Eigen::Vector3d(0.03, -0.02, 0.8)};
+  renderer.Render(object.mesh(), camera_from_model);
+  REQUIRE(renderer.covered_pixels().size() > 1000);
+  DepthImage depth{intrinsics.width, intrinsics.height,
+                   std::vector<float>(static_cast<std::size_t>(intrinsics.width) * intrinsics.height, 0.0f)};
+  Mask mask{intrinsics.width, intrinsics.height, std::vector<std::uint8_t>(depth.z.size(), 0)};
+  for (int pixel : renderer.covered_pixels()) {
+    depth.z[static_cast<std::size_t>(pixel)] = static_cast<float>(renderer.DepthAt(pixel % intrinsics.width, pixel / intrinsics.width));
+    mask.inside[static_cast<std::size_t>(pixel)] = 1;
+  }
+  // Through a .npy file (float32 metres).
+  c3po::test::TempDir dir("backproject_render");
+  c3po::WriteFileAtomically(dir / "d.npy", c3po::EncodeNpyDepth(depth));
+  const DepthImage read = c3po::ReadDepth(dir / "d.npy", 123.0 /* unused for .npy */);
+  CHECK(read.z == depth.z);
+  const c3po::PinholeCamera K{intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy};
+  const c3po::SegmentCloud segment = c3po::ExtractSegment(read, mask, K, NoPreprocessing(), "render");
+  REQUIRE(segment.cloud.cols() == static_cast<Eigen::Index>(renderer.covered_pixels().size()));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < segment.pixels.size(); ++i) {
+    const Eigen::Vector3d theirs = renderer.BackProject(segment.pixels[i]);
+    worst = std::max(worst, (segment.cloud.col(static_cast<Eigen::Index>(i)) - theirs).norm());
+  }
+  CHECK(worst < 1e-6);   // float32 depth at 0.8 m: ~1e-7 relative
+  // And they lie on the posed mesh (exact closest-point oracle on a subset).
+  for (Eigen::Index i = 0; i < segment.cloud.cols(); i += 211) {
+    const Eigen::Vector3d model_point = camera_from_model.InverseApply(segment.cloud.col(i));
+    CHECK(c3po::ClosestSurfacePoint(object.mesh(), model_point).distance < 1e-6);
+  }
+}
+
+TEST_CASE("masks: non-zero and label images; sizes must match the depth") {
+  c3po::Image label(4, 3, 8);
+  label.pixels = {0, 1, 2, 2, 5, 0, 2, 1, 0, 0, 7, 2};
+  CHECK(c3po::MaskFromImage(label).Count() == 8);
+  CHECK(c3po::MaskFromImage(label, 2).Count() == 4);
+  CHECK(c3po::MaskFromImage(label, 9).Count() == 0);
+  DepthImage depth{5, 3, std::vector<float>(15, 1.0f)};
+  const std::string error = ErrorOf([&] {
+    c3po::ExtractSegment(depth, c3po::MaskFromImage(label), kCamera, NoPreprocessing(), "m.png");
+  });
+  CHECK(error.find("m.png: depth is 5 x 3 but the mask is 4 x 3") == 0);
+}
+
+TEST_CASE("erosion equals the brute-force (2k+1)^2 window test, the image border does not erode") {
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const Mask mask = RandomMask(23 + static_cast<int>(seed), 17, seed, 0.85);
+    for (int k : {0, 1, 2, 4}) {
+      const Mask eroded = c3po::ErodeMask(mask, k);
+      for (int v = 0; v < mask.height; ++v) {
+        for (int u = 0; u < mask.width; ++u) {
+          bool all = true;
+          for (int dv = -k; dv <= k; ++dv) {
+            for (int du = -k; du <= k; ++du) {
+              const int x = u + du, y = v + dv;
+              if (x >= 0 && y >= 0 && x < mask.width && y < mask.height && !mask.at(x, y)) all = false;
+            }
+          }
+          REQUIRE(eroded.at(u, v) == all);
+        }
+      }
+    }
+  }
+  CHECK(c3po::ErodeMask(FullMask(5, 4), 3).Count() == 20);
+}
+
+TEST_CASE("preprocessing: counts add up, the discontinuity filter equals brute force, the bound strides") {
+  const int w = 40, h = 30;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> noise(-0.002, 0.002);
+  DepthImage depth{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      // A near box (0.5 m) in front of a far wall (1.5 m), holes, noise.
+      double z = (u > 10 && u < 30 && v > 8 && v < 22) ? 0.5 : 1.5;
+      if ((u * 7 + v * 3) % 29 == 0) z = 0.0;
+      depth.z[static_cast<std::size_t>(v) * w + u] = static_cast<float>(z > 0 ? z + noise(rng) : 0.0);
+    }
+  }
+  Mask mask{w, h, std::vector<std::uint8_t>(depth.z.size(), 0)};
+  for (int v = 7; v < 24; ++v) for (int u = 9; u < 32; ++u) mask.inside[static_cast<std::size_t>(v) * w + u] = 1;   // bleeds by ~2 px
+  for (int erode : {0, 1, 2}) {
+    for (double step : {0.0, 0.02, 0.1}) {
+      c3po::SegmentOptions options;
+      options.erode_mask = erode;
+      options.max_relative_depth_step = step;
+      options.max_points = 0;
+      const c3po::SegmentCloud s = c3po::ExtractSegment(depth, mask, kCamera, options, "x");
+      CHECK(s.mask_pixels == mask.Count());
+      CHECK(s.mask_pixels == s.no_depth + s.removed_by_erosion + s.removed_by_discontinuity + s.removed_by_subsampling +
+                                 static_cast<std::size_t>(s.cloud.cols()));
+      // Brute force over the eroded mask's pixels with depth.
+      const Mask eroded = c3po::ErodeMask(mask, erode);
+      std::vector<std::int32_t> expected;
+      for (int v = 0; v < h; ++v) {
+        for (int u = 0; u < w; ++u) {
+          const float z = depth.at(u, v);
+          if (!mask.at(u, v) || !(z > 0) || !eroded.at(u, v)) continue;
+          bool edge = false;
+          for (int dv = -1; dv <= 1; ++dv) {
+            for (int du = -1; du <= 1; ++du) {
+              const int x = u + du, y = v + dv;
+              if (x < 0 || y < 0 || x >= w || y >= h) continue;
+              const float zn = depth.at(x, y);
+              if (zn > 0 && std::abs(zn - z) > step * z) edge = true;
+            }
+          }
+          if (step > 0 && edge) continue;
+          expected.push_back(v * w + u);
+        }
+      }
+      CHECK(s.pixels == expected);
+      if (step > 0.0 && erode == 0) CHECK(s.removed_by_discontinuity > 0);
+      // No kept point is on the far wall once the filter or erosion is on.
+      if (erode + (step > 0.0 ? 1 : 0) >= 2) {   // the mask bleeds 2 px; the filter takes the ring next to the box
+        CHECK((s.cloud.row(2).array() < 1.0).all());
+      }
+    }
+  }
+  c3po::SegmentOptions bounded = NoPreprocessing();
+  bounded.max_points = 50;
+  const c3po::SegmentCloud all = c3po::ExtractSegment(depth, mask, kCamera, NoPreprocessing(), "x");
+  const c3po::SegmentCloud few = c3po::ExtractSegment(depth, mask, kCamera, bounded, "x");
+  REQUIRE(few.cloud.cols() == 50);
+  CHECK(few.removed_by_subsampling == static_cast<std::size_t>(all.cloud.cols() - 50));
+  CHECK(few.cloud == c3po::StridedColumns(all.cloud, 50));
+  for (Eigen::Index j = 0; j < 50; ++j) CHECK(few.pixels[static_cast<std::size_t>(j)] == all.pixels[static_cast<std::size_t>(j * all.cloud.cols() / 50)]);
+}
+
+TEST_CASE("unusable segments: no pixels, no depth, too few points left") {
+  DepthImage depth{6, 6, std::vector<float>(36, 0.0f)};
+  Mask empty{6, 6, std::vector<std::uint8_t>(36, 0)};
+  auto message = [&](const Mask& mask, const DepthImage& d) {
+    return ErrorOf([&] { c3po::RequireUsableSegment(c3po::ExtractSegment(d, mask, kCamera, c3po::SegmentOptions{}, "m.png"), "m.png"); });
+  };
+  CHECK(message(empty, depth) == "m.png: mask has no pixels");
+  CHECK(message(FullMask(6, 6), depth) == "m.png: no valid depth under the mask (36 pixels)");
+  depth.z.assign(36, std::nanf(""));
+  CHECK(message(FullMask(6, 6), depth) == "m.png: no valid depth under the mask (36 pixels)");
+  depth.z.assign(36, 1.0f);
+  Mask dot = empty;
+  dot.inside[14] = 1;
+  CHECK(message(dot, depth).find("m.png: only 0 points left after preprocessing") == 0);   // eroded away
+}
+
+TEST_CASE("COCO RLE: compressed == uncompressed == brute-force pixels (column-major runs)") {
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    const int w = 1 + static_cast<int>(seed * 7 % 31), h = 1 + static_cast<int>(seed * 5 % 23);
+    const Mask mask = RandomMask(w, h, seed, seed % 3 == 0 ? 0.97 : 0.4);
+    // Brute-force runs: column-major, starting with background.
+    c3po::RleCounts brute;
+    int current = 0;
+    std::int64_t run = 0;
+    for (int u = 0; u < w; ++u) {
+      for (int v = 0; v < h; ++v) {
+        const int value = mask.at(u, v);
+        if (value != current) { brute.push_back(run); run = 0; current = value; }
+        ++run;
+      }
+    }
+    brute.push_back(run);
+    const c3po::RleCounts counts = c3po::EncodeRle(mask);
+    CHECK(counts == brute);
+    const std::string compressed = c3po::RleString(counts);
+    CHECK(c3po::ParseRleString(compressed, "d.json") == counts);
+    CHECK(c3po::DecodeRle(h, w, counts, "d.json").inside == mask.inside);
+    CHECK(c3po::DecodeRle(h, w, c3po::ParseRleString(compressed, "d.json"), "d.json").inside == mask.inside);
+  }
+  // Large runs use several 5-bit groups and the delta coding (negative deltas).
+  const c3po::RleCounts big = {0, 100000, 3, 7, 250000, 1, 1};
+  CHECK(c3po::ParseRleString(c3po::RleString(big), "d") == big);
+  // Hand-encoded (maskApi.c rleToString): runs 0..2 as they are, run 3 as 5 - run 1 = 3.
+  CHECK(c3po::RleString({1, 2, 1, 5}) == "1213");
+  CHECK(c3po::ParseRleString("1213", "d") == c3po::RleCounts{1, 2, 1, 5});
+}
+
+TEST_CASE("malformed RLE is an InputError naming the file") {
+  CHECK(ErrorOf([] { c3po::ParseRleString("ab\x01", "d.json"); }).find("d.json: malformed RLE: character") == 0);
+  CHECK(ErrorOf([] { c3po::ParseRleString("1P", "d.json"); }).find("d.json: malformed RLE: string ends inside a run") == 0);
+  CHECK(ErrorOf([] { c3po::ParseRleString("oooooooooooooooo0", "d.json"); }).find("d.json: malformed RLE: run too long") == 0);
+  CHECK(ErrorOf([] { c3po::DecodeRle(4, 4, {3, 4}, "d.json"); }).find("d.json: malformed RLE: runs cover 7 pixels") == 0);
+  CHECK(ErrorOf([] { c3po::DecodeRle(4, 4, {3, 40}, "d.json"); }).find("d.json: malformed RLE: runs cover more") == 0);
+  CHECK(ErrorOf([] { c3po::DecodeRle(4, 4, {3, -1, 14}, "d.json"); }).find("d.json: malformed RLE: negative run") == 0);
+  CHECK(ErrorOf([] { c3po::DecodeRle(0, 4, {}, "d.json"); }).find("d.json: malformed RLE: bad size") == 0);
+}
+
+TEST_CASE("camera JSON: cam_K, BOP camera.json, one-entry scene_camera.json, --intrinsics; errors") {
+  const auto k = c3po::ParseCameraJson(R"({"cam_K": [600, 0, 320.5, 0, 610, 240, 0, 0, 1], "depth_scale": 0.1})", "c.json");
+  CHECK(k.K.fx == 600);
+  CHECK(k.K.fy == 610);
+  CHECK(k.K.cx == 320.5);
+  CHECK(k.K.cy == 240);
+  CHECK(k.depth_scale == 0.1);
+  const auto bop = c3po::ParseCameraJson(R"({"cx": 1, "cy": 2, "fx": 3, "fy": 4, "width": 640, "height": 480, "depth_scale": 1.0})", "camera.json");
+  CHECK((bop.K.fx == 3 && bop.K.fy == 4 && bop.K.cx == 1 && bop.K.cy == 2));
+  const auto scene = c3po::ParseCameraJson(R"({"7": {"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 0.5}})", "s.json");
+  CHECK(scene.depth_scale == 0.5);
+  CHECK(c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1]})", "c.json", 2.0).depth_scale == 2.0);
+  const auto intrinsics = c3po::CameraFromIntrinsics("500,501,300,200", 0.1);
+  CHECK((intrinsics.K.fx == 500 && intrinsics.K.cy == 200 && intrinsics.depth_scale == 0.1));
+
+  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"depth_scale": 1})", "c.json"); }) == "c.json: cam_K: missing (nor fx, fy, cx, cy)");
+  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1]})", "c.json"); }) ==
+        "c.json: depth_scale: missing (give --depth-scale S)");
+  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 0})", "c.json"); })
+            .find("c.json: depth_scale must be a positive number") == 0);
+  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": -1})", "c.json"); })
+            .find("c.json: depth_scale must be a positive number") == 0);
+  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4], "depth_scale": 1})", "c.json"); }) ==
+        "c.json: cam_K: expected 9 numbers (row-major 3x3)");
+  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0.5, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 1})", "c.json"); })
+            .find("c.json: cam_K: expected [fx, 0, cx, 0, fy, cy, 0, 0, 1]") == 0);
+  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [-1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 1})", "c.json"); })
+            .find("c.json: focal lengths must be positive") == 0);
+  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"1": {}, "2": {}})", "s.json"); }).find("s.json: a scene_camera.json of 2 images") == 0);
+  CHECK(ErrorOf([] { c3po::ParseCameraJson("{", "c.json"); }).find("c.json: not valid JSON") == 0);
+  CHECK(ErrorOf([] { c3po::CameraFromIntrinsics("1,2,3", 1.0); }) == "--intrinsics: expected 4 numbers fx,fy,cx,cy");
+  CHECK(ErrorOf([] { c3po::CameraFromIntrinsics("1,2,3,4", 0.0); }).find("--intrinsics/--depth-scale: depth_scale must be") == 0);
+}
+
+TEST_CASE(".npy depth: C and Fortran order, float64, strict header and size") {
+  DepthImage depth{3, 2, {0.5f, 0.0f, 1.5f, 2.0f, 2.5f, 3.0f}};
+  const std::string npy = c3po::EncodeNpyDepth(depth);
+  CHECK(c3po::ParseNpyDepth(npy, "d.npy").z == depth.z);
+  // Hand-built Fortran-order float64 file of the same image.
+  std::string header = "{'descr': '<f8', 'fortran_order': True, 'shape': (2, 3), }";
+  while ((10 + header.size() + 1) % 16 != 0) header += ' ';
+  header += '\n';
+  std::string f64("\x93NUMPY\x01\x00", 8);
+  f64 += static_cast<char>(header.size());
+  f64 += '\0';
+  f64 += header;
+  for (int u = 0; u < 3; ++u) {
+    for (int v = 0; v < 2; ++v) {
+      double z = depth.at(u, v);
+      if (u == 1 && v == 0) z = std::nan("");   // NaN = no measurement
+      f64.append(reinterpret_cast<const char*>(&z), 8);
+    }
+  }
+  CHECK(c3po::ParseNpyDepth(f64, "f.npy").z == depth.z);
+  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(npy.substr(0, npy.size() - 4), "d.npy"); }).find("d.npy: .npy data holds") == 0);
+  CHECK(ErrorOf([] { c3po::ParseNpyDepth("PK\x03\x04", "d.npy"); }) == "d.npy: not a .npy file (bad magic)");
+  std::string i16 = npy;
+  i16.replace(i16.find("<f4"), 3, "<i2");
+  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(i16, "d.npy"); }).find("d.npy: .npy dtype '<i2' is not float32") == 0);
+  std::string three = npy;
+  three.replace(three.find("(2, 3)"), 6, "(2,3,1)");
+  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(three, "d.npy"); }).find("d.npy: .npy depth must have shape (H, W)") == 0);
+  std::string no_tuple = npy;   // found by fuzz_npy: an empty shape value
+  no_tuple.replace(no_tuple.find("(2, 3)"), 6, " ,(23)");
+  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(no_tuple, "d.npy"); }) == "d.npy: .npy header: shape must be a tuple (H, W)");
+  DepthImage negative{1, 1, {-1.0f}};
+  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(c3po::EncodeNpyDepth(negative), "d.npy"); }) == "d.npy: negative or infinite depth in .npy");
+}
+
+TEST_CASE("depth PNG: value x depth_scale = mm, converted to metres; 8-bit depth refused") {
+  c3po::test::TempDir dir("depth_png");
+  c3po::Image png(2, 1, 16);
+  png.pixels = {1000, 65535};
+  c3po::WritePng(dir / "d.png", png);
+  CHECK(c3po::ReadDepth(dir / "d.png", 1.0).z == std::vector<float>{1.0f, 65.535f});
+  CHECK(c3po::ReadDepth(dir / "d.png", 0.1).z == std::vector<float>{0.1f, static_cast<float>(6.5535)});
+  c3po::Image eight(2, 1, 8);
+  c3po::WritePng(dir / "m.png", eight);
+  CHECK(ErrorOf([&] { c3po::ReadDepth(dir / "m.png", 1.0); }).find("8-bit PNG given as depth") != std::string::npos);
+}
+
+TEST_CASE("--shard K/N: disjoint contiguous parts whose concatenation is the whole, groups kept together") {
+  std::vector<std::int64_t> keys = {5, 5, 5, 6, 7, 7, 9, 10, 10, 10, 11};   // 6 groups
+  for (int n = 1; n <= 8; ++n) {
+    std::vector<std::size_t> all;
+    for (int k = 1; k <= n; ++k) {
+      const auto part = c3po::ShardJobs(keys, {k, n});
+      for (std::size_t i = 1; i < part.size(); ++i) CHECK(part[i] == part[i - 1] + 1);   // contiguous
+      all.insert(all.end(), part.begin(), part.end());
+    }
+    REQUIRE(all.size() == keys.size());
+    for (std::size_t i = 0; i < all.size(); ++i) CHECK(all[i] == i);
+  }
+  // A group never splits: with 2 parts of 6 groups the cut is after group 3 (key 7).
+  CHECK(c3po::ShardJobs(keys, {1, 2}) == std::vector<std::size_t>{0, 1, 2, 3, 4, 5});
+  CHECK(c3po::ParseShard("3/8").index == 3);
+  CHECK(ErrorOf([] { c3po::ParseShard("0/4"); }) == "--shard: '0/4': need 1 <= K <= N");
+  CHECK(ErrorOf([] { c3po::ParseShard("5/4"); }) == "--shard: '5/4': need 1 <= K <= N");
+  CHECK(ErrorOf([] { c3po::ParseShard("2"); }) == "--shard: '2' is not K/N (e.g. 3/8)");
+  CHECK(ErrorOf([] { c3po::MergeShardOutputs({{"a.csv", "scene_id,im_id,obj_id,score,R,t,time\n1,2,3,4,5,6,7\n"}, {"b.csv", "x\n"}}, true); }) ==
+        "b.csv: line 1: not a BOP results CSV header");
+  CHECK(c3po::MergeShardOutputs({{"a.csv", "scene_id,im_id,obj_id,score,R,t,time\n1\n"}, {"b.csv", "scene_id,im_id,obj_id,score,R,t,time\n2\n"}}, true) ==
+        "scene_id,im_id,obj_id,score,R,t,time\n1\n2\n");
+  CHECK(ErrorOf([] { c3po::MergeShardOutputs({{"a.jsonl", "{}\nnope\n"}}, false); }) == "a.jsonl: line 2: not a JSON object");
+}
