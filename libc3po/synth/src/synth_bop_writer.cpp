@@ -11,6 +11,7 @@
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/base/version.hpp"
 #include "c3po/base/interrupt.hpp"
 #include "c3po/base/parallel.hpp"
 #include "c3po/io/png_io.hpp"
