@@ -118,6 +118,9 @@ next_minor="${VERSION%%.*}.$(( $(echo "$VERSION" | cut -d. -f2) + 1 ))"
 echo "$found; find_package(c3po $next_minor) refused"
 
 # --- 4. The examples against oracles ---------------------------------------
+# (They are compiled with default flags, the libraries with -march=native:
+# they agree on Eigen's layout only through the exported EIGEN_MAX_ALIGN_BYTES;
+# without it certify_cloud crashed with "double free or corruption".)
 section "examples"
 MUG=$PREFIX/share/c3po/annotations/mug.json
 CLOUDS=$ROOT/build-examples/mug-clouds
