@@ -19,10 +19,32 @@ set(C3PO_INSTALL_TARGETS c3po_core c3po_plugins c3po_plugin_api)
 foreach(layer ${C3PO_INSTALL_LAYERS})
   list(APPEND C3PO_INSTALL_TARGETS c3po_${layer})
 endforeach()
-foreach(detector c3po_detector_svd c3po_detector_pointnet)
-  if(TARGET ${detector})
-    list(APPEND C3PO_INSTALL_TARGETS ${detector})
+# The built-in detectors: every c3po_detector_<name> that c3po::plugins links
+# (a new detector in plugins/<name>/ is installed without listing it here).
+# Include folders given as plain source paths become BUILD_INTERFACE ones, with
+# the installed include folder as their INSTALL_INTERFACE.
+set(C3PO_INSTALL_DETECTOR_HEADER_DIRS "")
+get_target_property(plugin_links c3po_plugins LINK_LIBRARIES)
+foreach(detector ${plugin_links})
+  if(NOT detector MATCHES "^c3po_detector_(.+)$" OR NOT TARGET ${detector})
+    continue()
   endif()
+  list(APPEND C3PO_INSTALL_TARGETS ${detector})
+  set_target_properties(${detector} PROPERTIES EXPORT_NAME detector_${CMAKE_MATCH_1})
+  get_target_property(dirs ${detector} INTERFACE_INCLUDE_DIRECTORIES)
+  set(interface_dirs "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
+  foreach(dir ${dirs})
+    if(dir MATCHES "^\\$<BUILD_INTERFACE:(.*)>$")
+      list(APPEND C3PO_INSTALL_DETECTOR_HEADER_DIRS ${CMAKE_MATCH_1})
+      list(APPEND interface_dirs "${dir}")
+    elseif(dir MATCHES "^\\$<")
+      continue()   # the INSTALL_INTERFACE, added once above
+    else()
+      list(APPEND C3PO_INSTALL_DETECTOR_HEADER_DIRS ${dir})
+      list(APPEND interface_dirs "$<BUILD_INTERFACE:${dir}>")
+    endif()
+  endforeach()
+  set_property(TARGET ${detector} PROPERTY INTERFACE_INCLUDE_DIRECTORIES "${interface_dirs}")
 endforeach()
 # Programs built against the installed libraries use the Eigen alignment they
 # were built with (cmake/C3poCompilerSettings.cmake).
@@ -37,12 +59,8 @@ install(TARGETS ${C3PO_INSTALL_TARGETS} EXPORT c3poTargets
 # Public headers only: each layer's include/ folder (never src/), the plugin
 # headers, and the generated version header.
 get_property(C3PO_INSTALL_HEADER_DIRS GLOBAL PROPERTY C3PO_INSTALL_HEADER_DIRS)
-list(APPEND C3PO_INSTALL_HEADER_DIRS ${PROJECT_SOURCE_DIR}/plugins/include)
-foreach(detector svd pointnet)
-  if(TARGET c3po_detector_${detector})
-    list(APPEND C3PO_INSTALL_HEADER_DIRS ${PROJECT_SOURCE_DIR}/plugins/${detector}/include)
-  endif()
-endforeach()
+list(APPEND C3PO_INSTALL_HEADER_DIRS ${PROJECT_SOURCE_DIR}/plugins/include ${C3PO_INSTALL_DETECTOR_HEADER_DIRS})
+list(REMOVE_DUPLICATES C3PO_INSTALL_HEADER_DIRS)
 foreach(dir ${C3PO_INSTALL_HEADER_DIRS})
   install(DIRECTORY ${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
           FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h")
@@ -83,9 +101,9 @@ install(FILES ${PROJECT_BINARY_DIR}/c3poConfig.cmake ${PROJECT_BINARY_DIR}/c3poC
 # pkg-config: c3po.pc, relocatable (prefix relative to the .pc file). Static
 # libraries, so their dependencies are Requires and Libs, not .private.
 set(C3PO_PC_LIBS "-lc3po_plugins")
-foreach(detector pointnet svd)
-  if(TARGET c3po_detector_${detector})
-    string(APPEND C3PO_PC_LIBS " -lc3po_detector_${detector}")
+foreach(target ${C3PO_INSTALL_TARGETS})
+  if(target MATCHES "^c3po_detector_")
+    string(APPEND C3PO_PC_LIBS " -l${target}")
   endif()
 endforeach()
 set(C3PO_PC_LAYERS ${C3PO_INSTALL_LAYERS})
