@@ -38,16 +38,6 @@ struct DemoCommand {
   bool quick = false;           // a smaller run (for tests)
 };
 
-// The bundled objects: next to the working directory's annotations/ when run
-// from the repository, else in the source tree this binary was built from.
-std::string DefaultObject() {
-  for (const std::string& candidate :
-       std::vector<std::string>{"annotations/mug.json", std::string(C3PO_SOURCE_DIR) + "/annotations/mug.json"}) {
-    if (fs::exists(candidate)) return candidate;
-  }
-  throw InputError("c3po demo", "bundled object annotations/mug.json not found (use --object FILE)");
-}
-
 std::string SelfExecutable() {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
@@ -60,6 +50,20 @@ std::string SelfExecutable() {
     path.resize(path.size() - deleted.size());
   }
   return path;
+}
+
+// The bundled objects: the working directory's annotations/ when run from the
+// repository, else the ones next to this executable: <prefix>/share/c3po/
+// annotations, found relative to the executable (no absolute path is built
+// in, so an installed tree can be moved; the build tree has the same layout).
+std::string DefaultObject() {
+  const fs::path bundled =
+      fs::path(SelfExecutable()).parent_path() / C3PO_DATADIR_FROM_BINDIR / "annotations/mug.json";
+  for (const std::string& candidate :
+       std::vector<std::string>{"annotations/mug.json", bundled.lexically_normal().string()}) {
+    if (fs::exists(candidate)) return candidate;
+  }
+  throw InputError("c3po demo", "bundled object annotations/mug.json not found (use --object FILE)");
 }
 
 // Prints "$ c3po ARGS" and runs it; a failing step stops the demo. Returns

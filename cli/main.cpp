@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "c3po/base/error.hpp"
+#include "c3po/base/version.hpp"
 #include "c3po/plugins/registry.hpp"
 #include "command.hpp"
 #include "signal_handlers.hpp"
@@ -66,8 +67,10 @@ std::string DetectorList() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"c3po: certifiable object pose estimation from partial point clouds (C-3PO)"};
-  app.set_version_flag("--version", std::string("c3po ") + C3PO_VERSION);
+  // Named "c3po" (not argv[0]): the help text is the same wherever c3po runs from.
+  CLI::App app{"c3po: certifiable object pose estimation from partial point clouds (C-3PO)", "c3po"};
+  app.set_version_flag("--version", std::string("c3po ") + C3PO_VERSION + " (plugin ABI " +
+                                          std::to_string(C3PO_BUILD_PLUGIN_ABI_VERSION) + ")");
   app.require_subcommand(1);
   app.footer(DetectorList());
 

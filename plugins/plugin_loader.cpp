@@ -6,8 +6,14 @@
 #include <string>
 
 #include "c3po/base/error.hpp"
+#include "c3po/base/version.hpp"
 #include "c3po/plugins/plugin_api.h"
 #include "registry_internal.hpp"
+
+// c3po --version reports the ABI from the generated version header; it must be
+// the one of the header this loader compiles against.
+static_assert(C3PO_BUILD_PLUGIN_ABI_VERSION == C3PO_PLUGIN_ABI_VERSION,
+              "c3po/base/version.hpp is stale: re-run cmake");
 
 namespace c3po {
 namespace {
@@ -61,8 +67,10 @@ void LoadPlugin(const std::string& path) {
   const c3po_detector_plugin* table = entry();
   if (!table) throw InputError(path, "plugin entry point returned no table");
   if (table->abi_version != C3PO_PLUGIN_ABI_VERSION) {
-    throw InputError(path, "plugin ABI version " + std::to_string(table->abi_version) +
-                               ", expected " + std::to_string(C3PO_PLUGIN_ABI_VERSION));
+    throw InputError(path, "plugin built for c3po plugin ABI version " + std::to_string(table->abi_version) +
+                               ", this c3po " C3PO_VERSION " loads ABI version " +
+                               std::to_string(C3PO_PLUGIN_ABI_VERSION) +
+                               " (rebuild the plugin against this c3po's plugin_api.h)");
   }
   if (!table->name || !*table->name || !table->create || !table->detect) {
     throw InputError(path, "plugin table lacks a name, create or detect");

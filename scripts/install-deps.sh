@@ -5,7 +5,10 @@
 set -euo pipefail
 packages=(build-essential cmake ninja-build ccache
           libeigen3-dev libnanoflann-dev libcli11-dev nlohmann-json3-dev doctest-dev
-          libassimp-dev tiny-dnn libcereal-dev libjs-three libspng-dev libpng-dev pkg-config parallel)
+          libassimp-dev tiny-dnn libcereal-dev libjs-three libspng-dev libpng-dev pkg-config parallel
+          dpkg-dev file python3)
+# dpkg-dev (dpkg-shlibdeps) and file: the Depends of the Debian package
+# (cpack -G DEB, scripts/check-install.sh); python3: test oracles.
 if [[ "${1:-}" != "--no-browser" ]]; then
   packages+=(chromium)
   # Node.js + npm run the browser tests (playwright-core from the npm registry);

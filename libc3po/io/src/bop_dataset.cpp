@@ -1,5 +1,6 @@
 // BOP instances -> c3po dataset folder (bop_dataset.hpp).
 #include "c3po/io/bop_dataset.hpp"
+#include "c3po/io/dataset_writer.hpp"
 
 #include <cstdio>
 #include <mutex>

@@ -13,6 +13,7 @@
 #include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
 #include "c3po/base/parallel.hpp"
+#include "c3po/base/version.hpp"
 #include "c3po/io/png_io.hpp"
 #include "c3po/synth/synth_bop.hpp"
 
