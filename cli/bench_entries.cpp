@@ -7,7 +7,10 @@ void SetupSynthBench(CLI::App& parent, std::function<int()>* run);
 void SetupPointNetBench(CLI::App& parent, std::function<int()>* run);
 void SetupMeshBench(CLI::App& parent, std::function<int()>* run);
 void SetupSynthBopBench(CLI::App& parent, std::function<int()>* run);
+void SetupDetectorBench(CLI::App& parent, std::function<int()>* run);
 
-std::vector<BenchEntry> BenchEntries() { return {{SetupSynthBench}, {SetupSynthBopBench}, {SetupPointNetBench}, {SetupMeshBench}}; }
+std::vector<BenchEntry> BenchEntries() {
+  return {{SetupSynthBench}, {SetupSynthBopBench}, {SetupPointNetBench}, {SetupMeshBench}, {SetupDetectorBench}};
+}
 
 }  // namespace c3po::cli

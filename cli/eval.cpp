@@ -234,7 +234,7 @@ RunFunction SetupEval(CLI::App& command) {
                      "KeyPo + RANSAC: keypoint inlier distance, distance or fraction of d (default 5%d)");
   command.add_option("--ransac-iterations", cmd->ransac_iterations,
                      "KeyPo + RANSAC: random triples when there are more (else every triple; default 1000)");
-  command.add_option("--seed", cmd->seed, "Seed of the RANSAC triples (default 0)");
+  AddSeedOption(command, &cmd->seed, "of the KeyPo + RANSAC triples; default 0");
   command.add_option("--icp-iterations", cmd->icp_iterations, "ICP iterations (default 30)");
   command.add_option("--icp-max-distance", cmd->icp_max_distance, "ICP correspondence gate (default: none)");
   command.add_option("--icp-trim", cmd->icp_trim, "ICP: fraction of the farthest pairs dropped (default 0)");
