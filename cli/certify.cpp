@@ -14,9 +14,6 @@
 #include "c3po/base/error.hpp"
 #include "c3po/io/bop.hpp"
 #include "c3po/io/dataset.hpp"
-#include "c3po/io/shard.hpp"
-#include "c3po/method/certify_batch.hpp"
-#include "c3po/method/image_sources.hpp"
 #include "c3po/object/object_io.hpp"
 #include "command.hpp"
 #include "options.hpp"
@@ -36,12 +33,6 @@ struct CertifyCommand {
   CorrectorFlags corrector;
   RobustFlags robust;
   bool no_correct = false;
-  // Images (one frame) and BOP datasets (docs/camera_inputs.md).
-  FrameFlags frame;
-  BopFlags bop;
-  SegmentOptions segment;
-  std::string bop_csv_path;
-  std::string shard;
 };
 
 std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
@@ -66,9 +57,96 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
   return text;
 }
 
+// The certify JSON line of a given pose, with the hypothesis and the change
+// the correction made appended (docs/design.md "Certifying given poses").
+std::string GivenPoseJsonLine(const std::string& cloud, const CloudOutcome& outcome,
+                              const PoseHypothesis& pose, bool chosen) {
+  std::string line = CertifyJsonLine(cloud, outcome.estimate);
+  line.pop_back();   // the closing brace
+  const PoseChange change = ChangeBetween(pose.scene_from_model, outcome.estimate.scene_from_model);
+  char extra[256];
+  std::snprintf(extra, sizeof extra,
+                ",\"pose_line\":%d,\"score\":%.17g,\"rotation_change_deg\":%.17g,\"translation_change\":%.17g,"
+                "\"chosen\":%s}",
+                pose.line, pose.score, change.rotation_degrees, change.translation, chosen ? "true" : "false");
+  return line + extra;
+}
+
+// c3po certify --poses: every hypothesis matched to a cloud is certified; per
+// instance the certified one with the best fit is chosen (given_poses.hpp).
+int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const CertifyBatchOptions& options,
+                  const std::vector<CloudSource>& clouds) {
+  const std::vector<PoseHypothesis> poses = ReadPoseList(cmd.poses_path);
+  const GivenPoseSources matched = MatchGivenPoses(object, clouds, poses);
+  for (std::size_t h : matched.unmatched) {
+    std::cerr << "c3po certify: " << cmd.poses_path << ": line " << poses[h].line << ": no cloud named '"
+              << PoseMatchKey(poses[h]) << "' (unmatched)\n";
+  }
+  ProgressBar progress("certify", matched.sources.size());
+  const CertifyBatchResult result =
+      matched.sources.empty() ? CertifyBatchResult{}
+                              : CertifyBatch(object, matched.sources, nullptr, options,
+                                             [&](std::size_t done, std::size_t) { progress.Update(done); });
+  progress.Finish();
+  const std::vector<InstanceVerdict> verdicts = ChooseCertified(matched, poses, result);
+  std::vector<bool> chosen(matched.sources.size(), false);
+  for (const auto& v : verdicts) {
+    if (v.chosen) chosen[*v.chosen] = true;
+  }
+  std::ostringstream json_lines;
+  int errors = static_cast<int>(matched.unmatched.size());
+  for (std::size_t s = 0; s < matched.sources.size(); ++s) {
+    const CloudOutcome& outcome = result.outcomes[s];
+    const PoseHypothesis& pose = poses[matched.hypothesis[s]];
+    const std::string& name = matched.sources[s].name;
+    if (!outcome.processed()) {
+      ++errors;
+      std::cerr << "c3po certify: " << outcome.error << "\n";
+      if (cmd.json) json_lines << CertifyErrorJsonLine(name, outcome.error) << "\n";
+      continue;
+    }
+    if (cmd.json || !cmd.output_path.empty()) json_lines << GivenPoseJsonLine(name, outcome, pose, chosen[s]) << "\n";
+    if (!cmd.json) {
+      const PoseChange change = ChangeBetween(pose.scene_from_model, outcome.estimate.scene_from_model);
+      std::printf("%s  change %.3g deg, %.4g%s\n", HumanLine(name, outcome).c_str(), change.rotation_degrees,
+                  change.translation, chosen[s] ? "  CHOSEN" : "");
+    }
+  }
+  for (std::size_t h : matched.unmatched) {
+    if (cmd.json) {
+      json_lines << CertifyErrorJsonLine(PoseMatchKey(poses[h]),
+                                         cmd.poses_path + ": line " + std::to_string(poses[h].line) + ": unmatched")
+                 << "\n";
+    }
+  }
+  if (!cmd.output_path.empty()) {
+    WriteFileAtomically(cmd.output_path, json_lines.str());
+  } else if (cmd.json) {
+    std::cout << json_lines.str();
+  }
+  int instances_certified = 0;
+  for (const auto& v : verdicts) instances_certified += v.chosen ? 1 : 0;
+  if (!cmd.json) {
+    for (const auto& v : verdicts) {
+      std::printf("%s: %s\n", clouds[v.instance].name.c_str(),
+                  v.chosen ? ("certified hypothesis: line " + std::to_string(poses[matched.hypothesis[*v.chosen]].line)).c_str()
+                           : "no certified hypothesis");
+    }
+    std::printf("instances with a certified pose %d/%zu (hypotheses %zu, unmatched %zu, errors %d)\n",
+                instances_certified, verdicts.size(), matched.sources.size(), matched.unmatched.size(),
+                errors - static_cast<int>(matched.unmatched.size()));
+  }
+  if (errors > 0) return 2;
+  return instances_certified == static_cast<int>(verdicts.size()) && !verdicts.empty() ? 0 : 1;
+}
+
 int Run(const CertifyCommand& cmd) {
-  if (cmd.detector.models.size() + cmd.detector.detectors.size() != 1) {
-    throw InputError("c3po certify", "give exactly one of --model FILE or --detector NAME");
+  const std::size_t detectors = cmd.detector.models.size() + cmd.detector.detectors.size();
+  if (!cmd.poses_path.empty() && detectors != 0) {
+    throw InputError("c3po certify", "--poses replaces the detector: give no --model / --detector with it");
+  }
+  if (cmd.poses_path.empty() && detectors != 1) {
+    throw InputError("c3po certify", "give exactly one of --model FILE, --detector NAME or --poses FILE");
   }
   const ObjectModel object = LoadObject(cmd.object_path);
   CertifyBatchOptions options;
@@ -99,10 +177,6 @@ int Run(const CertifyCommand& cmd) {
     }
     append(BopSources(listed, cmd.segment));
   }
-  if (sources.empty()) {
-    throw InputError("c3po certify", "no clouds given (CLOUD..., --data DIR, --depth/--mask or --bop DIR)");
-  }
-  if (shard) sources = ShardSources(sources, *shard);
   LoadPlugins(cmd.detector);
   const std::unique_ptr<Detector> detector =
       MakeDetector(cmd.detector.models.empty() ? "" : cmd.detector.models.front(),
@@ -159,7 +233,11 @@ RunFunction SetupCertify(CLI::App& command) {
   command.add_flag("--json", cmd->json, "One JSON object per cloud on stdout");
   command.add_option("-o,--output", cmd->output_path, "Write the JSON lines to this file (atomically)");
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kAllowed);
-  command.add_flag("--no-correct", cmd->no_correct, "Certify the plain registration of the detected keypoints");
+  command.add_flag("--no-correct", cmd->no_correct,
+                   "Certify the plain registration of the detected keypoints (with --poses: the given pose as is)");
+  command.add_option("--poses", cmd->poses_path,
+                     "Certify these poses (BOP results CSV or JSON lines with cloud, R, t) instead of detecting; "
+                     "matched to the clouds by name (docs/design.md)");
   AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);
   AddFrameOptions(command, &cmd->frame);

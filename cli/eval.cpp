@@ -2,6 +2,7 @@
 // certified subsets) on a dataset with ground truth; terminal table, JSON and
 // a self-contained HTML report.
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -38,6 +39,10 @@ struct EvalCommand {
   CorrectorFlags corrector;
   RobustFlags robust;
   bool no_icp = false;
+  bool no_ransac = false;
+  std::string ransac_threshold = "5%d";
+  int ransac_iterations = 1000;
+  std::uint64_t seed = 0;
   int icp_iterations = 30;
   std::string icp_max_distance;
   double icp_trim = 0.0;
@@ -132,6 +137,10 @@ EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object,
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
   options.run_icp = !cmd.no_icp;
+  options.run_ransac = !cmd.no_ransac;
+  options.ransac.inlier_threshold = ParseThreshold(cmd.ransac_threshold, d, "--ransac-threshold");
+  options.ransac.max_iterations = cmd.ransac_iterations;
+  options.ransac.seed = cmd.seed;
   options.icp.max_iterations = cmd.icp_iterations;
   options.icp.trim_fraction = cmd.icp_trim;
   if (!cmd.icp_max_distance.empty()) {
@@ -197,6 +206,10 @@ std::string CommandLine(const EvalCommand& cmd) {
   if (!cmd.thresholds.delta_nd.empty()) line += " --delta-nd " + cmd.thresholds.delta_nd;
   line += RobustCommandLine(cmd.robust);
   if (cmd.no_icp) line += " --no-icp";
+  if (cmd.no_ransac) line += " --no-ransac";
+  if (!cmd.no_icp && !cmd.no_ransac) {
+    line += " --ransac-threshold " + cmd.ransac_threshold + " --seed " + std::to_string(cmd.seed);
+  }
   return line;
 }
 
@@ -286,7 +299,13 @@ RunFunction SetupEval(CLI::App& command) {
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kRefused);
   AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);
-  command.add_flag("--no-icp", cmd->no_icp, "Skip the KeyPo + ICP rows");
+  command.add_flag("--no-icp", cmd->no_icp, "Skip the KeyPo + ICP and KeyPo + RANSAC + ICP rows");
+  command.add_flag("--no-ransac", cmd->no_ransac, "Skip the KeyPo + RANSAC + ICP rows");
+  command.add_option("--ransac-threshold", cmd->ransac_threshold,
+                     "KeyPo + RANSAC: keypoint inlier distance, distance or fraction of d (default 5%d)");
+  command.add_option("--ransac-iterations", cmd->ransac_iterations,
+                     "KeyPo + RANSAC: random triples when there are more (else every triple; default 1000)");
+  AddSeedOption(command, &cmd->seed, "of the KeyPo + RANSAC triples; default 0");
   command.add_option("--icp-iterations", cmd->icp_iterations, "ICP iterations (default 30)");
   command.add_option("--icp-max-distance", cmd->icp_max_distance, "ICP correspondence gate (default: none)");
   command.add_option("--icp-trim", cmd->icp_trim, "ICP: fraction of the farthest pairs dropped (default 0)");

@@ -103,7 +103,7 @@ void AddDetectorOptions(CLI::App& command, DetectorFlags* flags, DetectorCount c
       many ? "Trained detector model file (row label = file stem); repeatable" : "Trained detector model file");
   CLI::Option* detector = command.add_option(
       "--detector", flags->detectors,
-      std::string("Detector without a model file (svd, manifest = the manifest's detected_keypoints, or a "
+      std::string("Detector without a model file (svd, fpfh, manifest = the manifest's detected_keypoints, or a "
                   "plugin's)") + (many ? "; repeatable" : ""));
   CLI::Option* plugin =
       command.add_option("--plugin", flags->plugins, "Load a detector plugin (shared library); repeatable");

@@ -4,6 +4,9 @@
 #ifdef C3PO_HAVE_SVD
 #include "c3po/plugins/svd_detector.hpp"
 #endif
+#ifdef C3PO_HAVE_FPFH
+#include "c3po/plugins/fpfh_detector.hpp"
+#endif
 #ifdef C3PO_HAVE_POINTNET
 #include "c3po/plugins/pointnet.hpp"
 #endif
@@ -23,6 +26,12 @@ void RegisterBuiltinDetectors() {
                        return std::make_unique<SvdDetector>(object);
                      });
   }
+#endif
+#ifdef C3PO_HAVE_FPFH
+  RegisterDetector({"fpfh", "FPFH matching + TEASER-style robust registration (no training)", false},
+                   [](const ObjectModel& object) -> std::unique_ptr<Detector> {
+                     return std::make_unique<FpfhDetector>(object);
+                   });
 #endif
 #ifdef C3PO_HAVE_POINTNET
   RegisterModelLoader({"pointnet", "PointNet keypoint regressor (tiny-dnn); train with c3po train", true},

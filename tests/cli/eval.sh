@@ -21,7 +21,7 @@ cat > train.log.jsonl <<'LOG'
 LOG
 "$C3PO" eval "$OBJECT" --data data --detector manifest --json out.json --report report.html \
   --training-log train.log.jsonl > table.txt 2> err.txt || { cat table.txt err.txt; fail "eval exited with $?"; }
-for text in "KeyPo (manifest)  " "KeyPo (manifest) + ICP" "KeyPo (manifest) + corrector" \
+for text in "KeyPo (manifest)  " "KeyPo (manifest) + ICP" "KeyPo (manifest) + RANSAC + ICP" "KeyPo (manifest) + corrector" \
             "ADD-S variant: symmetric" "Soundness:" "eps_oc ="; do
   grep -qF "$text" table.txt || { cat table.txt; fail "table lacks '$text'"; }
 done
@@ -40,7 +40,7 @@ e = json.load(open(sys.argv[1]))
 assert e["adds_variant"] == "symmetric", e["adds_variant"]
 assert abs(e["adds_threshold"] - 0.05 * e["diameter"]) < 1e-12
 assert abs(e["auc_max"] - 0.10 * e["diameter"]) < 1e-12
-assert [r["label"] for r in e["rows"]] == ["KeyPo (manifest)", "KeyPo (manifest) + ICP", "KeyPo (manifest) + corrector"]
+assert [r["label"] for r in e["rows"]] == ["KeyPo (manifest)", "KeyPo (manifest) + ICP", "KeyPo (manifest) + RANSAC + ICP", "KeyPo (manifest) + corrector"]
 for r in e["rows"]:
     s, samples = r["summary"], r["samples"]
     assert s["n"] == len(samples) == e["clouds"] == 10

@@ -222,6 +222,26 @@ check bop_malformed_rle "2" bop.jsonl detections_bad_rle.json split_ok detection
 check bop_rle_too_long "2" bop.jsonl detections_rle_long.json split_ok detections_rle_long.json -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop split_ok --detections detections_rle_long.json
 check bop_not_a_folder "2" bop.jsonl camera.json camera.json -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop camera.json
 check shard_out_of_range "2" bop.jsonl shard split_ok -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop split_ok --shard 5/4
+# --- pose files (certify --poses; BOP CSV and JSON lines) -------------------
+bop_header='scene_id,im_id,obj_id,score,R,t,time'
+: > empty_poses.csv
+check poses_empty "2" poses_out.jsonl empty_poses.csv empty_poses.csv sim -- "$C3PO" certify "$CUBE" --data sim --poses empty_poses.csv -o poses_out.jsonl
+printf '%s\n1,2,3,0.5,1 0 0 0 1 0 0 0 1,0 0\n' "$bop_header" > truncated_poses.csv
+check poses_truncated_row "2" poses_out.jsonl truncated_poses.csv truncated_poses.csv sim -- "$C3PO" certify "$CUBE" --data sim --poses truncated_poses.csv -o poses_out.jsonl
+printf '%s\n1,2,3,0.5,1 0 0 0 1 0 0 0 1,0 nan 0,-1\n' "$bop_header" > nan_poses.csv
+check poses_nan_t "2" poses_out.jsonl nan_poses.csv nan_poses.csv sim -- "$C3PO" certify "$CUBE" --data sim --poses nan_poses.csv -o poses_out.jsonl
+printf '%s\n1,2,3,0.5,1 0 0 0 1 0 0 0 2,0 0 0,-1\n' "$bop_header" > scaled_poses.csv
+check poses_not_rotation "2" poses_out.jsonl scaled_poses.csv scaled_poses.csv sim -- "$C3PO" certify "$CUBE" --data sim --poses scaled_poses.csv -o poses_out.jsonl
+printf '%s\n1,2,3,0.5,1 0 0 0 1 0 0 0 1,0 0 1e400,-1\n' "$bop_header" > huge_poses.csv
+check poses_huge_number "2" poses_out.jsonl huge_poses.csv huge_poses.csv sim -- "$C3PO" certify "$CUBE" --data sim --poses huge_poses.csv -o poses_out.jsonl
+printf '{"cloud": "000000.ply", "R": [[1,0,0],[0,1,0]], "t": [0,0,0]}\n' > short_r.jsonl
+check poses_short_R "2" poses_out.jsonl short_r.jsonl short_r.jsonl sim -- "$C3PO" certify "$CUBE" --data sim --poses short_r.jsonl -o poses_out.jsonl
+printf '{"cloud": "000000.ply", "R": [[1,0,0],[0,1,0],[0,0,1]], "t": [0,0,' > truncated.jsonl
+check poses_truncated_json "2" poses_out.jsonl truncated.jsonl truncated.jsonl sim -- "$C3PO" certify "$CUBE" --data sim --poses truncated.jsonl -o poses_out.jsonl
+mkdir -p dir_as_poses.csv
+check poses_directory "2" poses_out.jsonl dir_as_poses.csv dir_as_poses.csv sim -- "$C3PO" certify "$CUBE" --data sim --poses dir_as_poses.csv -o poses_out.jsonl
+printf '{"cloud": "nowhere.ply", "R": [[1,0,0],[0,1,0],[0,0,1]], "t": [0,0,0]}\n' > unmatched.jsonl
+check poses_unmatched "2" - unmatched.jsonl unmatched.jsonl sim -- "$C3PO" certify "$CUBE" --data sim --poses unmatched.jsonl
 
 # --- outputs that cannot be written (ENOTDIR, see the note at the top) ------
 printf 'a regular file\n' > blocker

@@ -147,11 +147,24 @@ TEST_CASE("KeyPo, ICP and corrector rows match brute-force ADD-S, certificates a
   EvaluationOptions options = EvaluationOptions::Defaults(f.object);
   REQUIRE(options.adds_variant == AddSVariant::kSymmetric);
   const Evaluation e = Evaluate(f.object, f.dataset, {{"manifest", nullptr, false}}, options);
-  REQUIRE(e.rows.size() == 3);
+  REQUIRE(e.rows.size() == 4);
   CHECK(e.rows[0].label == "KeyPo (manifest)");
   CHECK(e.rows[1].label == "KeyPo (manifest) + ICP");
-  CHECK(e.rows[2].label == "KeyPo (manifest) + corrector");
+  CHECK(e.rows[2].label == "KeyPo (manifest) + RANSAC + ICP");
+  CHECK(e.rows[3].label == "KeyPo (manifest) + corrector");
   CHECK(e.clouds == kClouds);
+  // Every detection here is consistent (exact, or exactly turned): RANSAC keeps
+  // every keypoint, so its start is eq. (8)'s and ICP ends at the same pose.
+  for (int i = 0; i < kClouds; ++i) {
+    const SampleResult& icp = e.rows[1].samples[i];
+    const SampleResult& ransac = e.rows[2].samples[i];
+    CAPTURE(i);
+    CHECK(icp.ok() == ransac.ok());
+    if (icp.ok() && ransac.ok()) {
+      CHECK((icp.scene_from_model.R - ransac.scene_from_model.R).norm() < 1e-6);
+      CHECK((icp.scene_from_model.t - ransac.scene_from_model.t).norm() < 1e-6);
+    }
+  }
 
   // The registration of exact keypoints is the pose that posed them.
   const EvaluationRow& keypo = e.rows[0];

@@ -10,6 +10,7 @@
 #include "c3po/base/error.hpp"
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/certify_batch.hpp"
+#include "c3po/method/keypoint_ransac.hpp"
 
 namespace c3po {
 namespace {
@@ -18,7 +19,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The three estimates of one detector on one cloud, indexed by Stage.
-enum Stage { kRegistration = 0, kIcp = 1, kCorrected = 2, kStages = 3 };
+enum Stage { kRegistration = 0, kIcp = 1, kCorrected = 2, kRansacIcp = 3, kStages = 4 };
 
 using DetectorResults = std::vector<std::vector<SampleResult>>;   // [stage][cloud]
 
@@ -71,14 +72,27 @@ SampleResult FromEstimate(std::size_t index, const std::string& cloud, const Pos
 
 // "KeyPo + ICP": ICP from the registration, certified with keypoints T·b.
 SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
-                              const SampleResult& registration, const EvaluationOptions& options) {
+                              const SampleResult& registration, const EvaluationOptions& options,
+                              bool ransac = false) {
   if (!registration.ok()) {
     SampleResult failed = Failure(registration.index, registration.cloud, registration.error);
     failed.detected_keypoints = registration.detected_keypoints;
     return failed;
   }
   const auto start = std::chrono::steady_clock::now();
-  const IcpResult icp = RefineIcp(object, cloud, registration.scene_from_model, options.icp);
+  Pose initial = registration.scene_from_model;
+  if (ransac) {
+    // "KeyPo + RANSAC + ICP": RANSAC over triples of (ỹ_i, b_i) replaces eq. (8) on all of ỹ.
+    const KeypointRansacResult fit =
+        RegisterKeypointsRansac(object.keypoints(), registration.detected_keypoints, options.ransac);
+    if (!fit.ok()) {
+      SampleResult failed = Failure(registration.index, registration.cloud, "ransac: " + fit.failure);
+      failed.detected_keypoints = registration.detected_keypoints;
+      return failed;
+    }
+    initial = fit.scene_from_model;
+  }
+  const IcpResult icp = RefineIcp(object, cloud, initial, options.icp);
   if (!icp.ok()) {
     SampleResult failed = Failure(registration.index, registration.cloud, "icp: " + icp.failure);
     failed.detected_keypoints = registration.detected_keypoints;
@@ -121,6 +135,10 @@ DetectorResults EvaluateDetector(const ObjectModel& object, const Dataset& datas
       if (options.run_icp) {
         out[kIcp][i] = RefineAndCertify(object, cloud, out[kRegistration][i], options);
         ScoreAgainstTruth(object, truth, options, &out[kIcp][i]);
+        if (options.run_ransac) {
+          out[kRansacIcp][i] = RefineAndCertify(object, cloud, out[kRegistration][i], options, true);
+          ScoreAgainstTruth(object, truth, options, &out[kRansacIcp][i]);
+        }
       }
     }
     out[kCorrected][i] = FromEstimate(i, name, outcome->estimate);
@@ -190,6 +208,10 @@ void AppendRows(const EvaluatedDetector& detector, DetectorResults results,
   if (options.run_icp) {
     rows->push_back(MakeRow(EvalMethod::kKeyPoIcp, EvalSubset::kAll, label, std::move(results[kIcp]),
                             options, diameter));
+    if (options.run_ransac) {
+      rows->push_back(MakeRow(EvalMethod::kKeyPoRansacIcp, EvalSubset::kAll, label,
+                              std::move(results[kRansacIcp]), options, diameter));
+    }
   }
   rows->push_back(MakeRow(EvalMethod::kKeyPoCorrector, EvalSubset::kAll, label,
                           std::move(results[kCorrected]), options, diameter));
@@ -209,6 +231,7 @@ void EvaluationOptions::Check() const {
   if (worst_listed < 0) throw std::invalid_argument("EvaluationOptions: worst_listed must be >= 0");
   pipeline.Check();
   if (run_icp) icp.Check();
+  if (run_icp && run_ransac) ransac.Check();
 }
 
 EvaluationOptions EvaluationOptions::Defaults(const ObjectModel& object) {
@@ -216,6 +239,7 @@ EvaluationOptions EvaluationOptions::Defaults(const ObjectModel& object) {
   options.adds_threshold = 0.05 * object.diameter();
   options.auc_max = 0.10 * object.diameter();
   options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
+  options.ransac.inlier_threshold = 0.05 * object.diameter();
   return options;
 }
 
@@ -223,6 +247,7 @@ const char* ToString(EvalMethod method) {
   switch (method) {
     case EvalMethod::kKeyPo: return "keypo";
     case EvalMethod::kKeyPoIcp: return "keypo+icp";
+    case EvalMethod::kKeyPoRansacIcp: return "keypo+ransac+icp";
     case EvalMethod::kKeyPoCorrector: return "keypo+corrector";
     case EvalMethod::kC3po: return "c3po";
   }
@@ -243,6 +268,7 @@ std::string RowLabel(EvalMethod method, EvalSubset subset, const std::string& de
   switch (method) {
     case EvalMethod::kKeyPo: label = "KeyPo (" + detector_label + ")"; break;
     case EvalMethod::kKeyPoIcp: label = "KeyPo (" + detector_label + ") + ICP"; break;
+    case EvalMethod::kKeyPoRansacIcp: label = "KeyPo (" + detector_label + ") + RANSAC + ICP"; break;
     case EvalMethod::kKeyPoCorrector: label = "KeyPo (" + detector_label + ") + corrector"; break;
     case EvalMethod::kC3po: label = "C-3PO (" + detector_label + ")"; break;
   }

@@ -7,6 +7,9 @@
 //                           certified like any other output (oc, nd);
 //   "KeyPo (L) + ICP"       point-to-point ICP against X from T(ỹ) (RefineIcp),
 //                           certified with keypoints T·b (agreement check trivial);
+//   "KeyPo (L) + RANSAC + ICP"  RANSAC over triples of (ỹ_i, b_i)
+//                           (RegisterKeypointsRansac) instead of eq. (8) on all
+//                           of ỹ, then the same ICP and certification;
 //   "KeyPo (L) + corrector" the corrector (eq. 17) from ỹ, certified.
 // For a self-trained detector (Section VII) the corrector rows are named
 //   "C-3PO (L)", "C-3PO (L) (oc = 1)", "C-3PO (L) (oc = nd = 1)"
@@ -29,6 +32,7 @@
 #include "c3po/io/dataset.hpp"
 #include "c3po/method/detector.hpp"
 #include "c3po/method/icp.hpp"
+#include "c3po/method/keypoint_ransac.hpp"
 #include "c3po/method/pipeline.hpp"
 #include "c3po/object/object_model.hpp"
 
@@ -40,7 +44,9 @@ struct EvaluationOptions {
   AddSVariant adds_variant = AddSVariant::kSymmetric;
   PipelineOptions pipeline;        // corrector + certificate thresholds (absolute)
   IcpOptions icp;
-  bool run_icp = true;             // false: no "+ ICP" rows
+  bool run_icp = true;             // false: no "+ ICP" rows (nor "+ RANSAC + ICP")
+  bool run_ransac = true;          // false: no "+ RANSAC + ICP" rows
+  KeypointRansacOptions ransac;    // Defaults: inlier threshold 5 % of d
   int worst_listed = 5;            // false certificates listed per row
   void Check() const;              // throws std::invalid_argument
   // Paper defaults: thresholds 5 % and 10 % of d; certificate thresholds of the object.
@@ -54,9 +60,9 @@ struct EvaluatedDetector {
   bool self_trained = false;
 };
 
-enum class EvalMethod { kKeyPo, kKeyPoIcp, kKeyPoCorrector, kC3po };
+enum class EvalMethod { kKeyPo, kKeyPoIcp, kKeyPoCorrector, kC3po, kKeyPoRansacIcp };
 enum class EvalSubset { kAll, kObservablyCorrect, kCertified };
-const char* ToString(EvalMethod method);   // "keypo", "keypo+icp", "keypo+corrector", "c3po"
+const char* ToString(EvalMethod method);   // "keypo", "keypo+icp", "keypo+corrector", "c3po", "keypo+ransac+icp"
 const char* ToString(EvalSubset subset);   // "all", "oc=1", "oc=nd=1"
 // "KeyPo (sim) + ICP", "C-3PO (real) (oc = nd = 1)", ...
 std::string RowLabel(EvalMethod method, EvalSubset subset, const std::string& detector_label);
@@ -133,7 +139,7 @@ RowSummary Summarize(const std::vector<SampleResult>& samples, const EvaluationO
 
 // Runs every detector on every cloud of the dataset (in parallel over clouds)
 // and returns the rows in the order: for each detector, its KeyPo, + ICP,
-// + corrector rows (or its three C-3PO rows when self-trained). Throws
+// + RANSAC + ICP, + corrector rows (or its three C-3PO rows when self-trained). Throws
 // InputError("dir/manifest.jsonl: ...") when an entry has no ground-truth pose
 // or, for a manifest detector, no detected_keypoints; std::invalid_argument
 // for bad options. Unreadable clouds and detector failures are per-sample

@@ -1,0 +1,58 @@
+#pragma once
+// Certificates for poses from any estimator (`c3po certify --poses FILE`,
+// docs/design.md "Certifying given poses"). The certificates need only the
+// cloud and a pose (paper Theorems 7, 12), so a given pose T enters the one
+// batch path (certify_batch.hpp) as given keypoints ỹ = T·b: without
+// correction the registration of T·b onto b is T itself (eq. 8 is exact on
+// noise-free correspondences), with correction T·b is the corrector's start.
+//
+// Matching rule (a hypothesis to a cloud source): a hypothesis naming a
+// "cloud" matches the source whose name is exactly that text; a hypothesis
+// without "cloud" but with scene_id and im_id matches the source named
+// "scene_id/im_id" (decimal, no padding; the names of BOP sources). Nothing
+// else matches; unmatched hypotheses are listed, never dropped silently.
+// Several hypotheses may match one source (the instance's hypotheses).
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "c3po/io/pose_list.hpp"
+#include "c3po/method/certify_batch.hpp"
+#include "c3po/object/object_model.hpp"
+
+namespace c3po {
+
+struct GivenPoseSources {
+  std::vector<CloudSource> sources;        // one per matched hypothesis, in file order
+  std::vector<std::size_t> hypothesis;     // per source: index into the poses
+  std::vector<std::size_t> instance;       // per source: index into the cloud sources
+  std::vector<std::size_t> unmatched;      // indices into the poses
+};
+
+// The key a hypothesis is matched by (see the rule above).
+std::string PoseMatchKey(const PoseHypothesis& pose);
+
+GivenPoseSources MatchGivenPoses(const ObjectModel& object, const std::vector<CloudSource>& clouds,
+                                 const std::vector<PoseHypothesis>& poses);
+
+// The change the correction made to a given pose.
+struct PoseChange {
+  double rotation_degrees = 0.0;   // angle of R_given^T R_estimate
+  double translation = 0.0;        // |t_estimate - t_given|, object units
+};
+PoseChange ChangeBetween(const Pose& given, const Pose& estimate);
+
+// Per instance (cloud source) with at least one hypothesis: the certified
+// hypothesis with the best fit (smallest oc distance, then the higher score,
+// then the earlier line), or none.
+struct InstanceVerdict {
+  std::size_t instance = 0;                // index into the cloud sources
+  std::vector<std::size_t> sources;        // its hypotheses' indices into GivenPoseSources::sources
+  std::optional<std::size_t> chosen;       // index into GivenPoseSources::sources
+};
+std::vector<InstanceVerdict> ChooseCertified(const GivenPoseSources& matched,
+                                             const std::vector<PoseHypothesis>& poses,
+                                             const CertifyBatchResult& result);
+
+}  // namespace c3po

@@ -1,0 +1,71 @@
+#include "c3po/method/given_poses.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <unordered_map>
+
+namespace c3po {
+
+std::string PoseMatchKey(const PoseHypothesis& pose) {
+  if (!pose.cloud.empty()) return pose.cloud;
+  if (pose.scene_id && pose.im_id) return std::to_string(*pose.scene_id) + "/" + std::to_string(*pose.im_id);
+  return "";
+}
+
+GivenPoseSources MatchGivenPoses(const ObjectModel& object, const std::vector<CloudSource>& clouds,
+                                 const std::vector<PoseHypothesis>& poses) {
+  std::unordered_map<std::string, std::size_t> by_name;
+  for (std::size_t i = 0; i < clouds.size(); ++i) by_name.emplace(clouds[i].name, i);   // first wins
+  GivenPoseSources matched;
+  for (std::size_t h = 0; h < poses.size(); ++h) {
+    const auto it = by_name.find(PoseMatchKey(poses[h]));
+    if (it == by_name.end()) {
+      matched.unmatched.push_back(h);
+      continue;
+    }
+    CloudSource source = clouds[it->second];
+    source.name += " (line " + std::to_string(poses[h].line) + ")";
+    source.given_keypoints = poses[h].scene_from_model * object.keypoints();
+    matched.sources.push_back(std::move(source));
+    matched.hypothesis.push_back(h);
+    matched.instance.push_back(it->second);
+  }
+  return matched;
+}
+
+PoseChange ChangeBetween(const Pose& given, const Pose& estimate) {
+  PoseChange change;
+  const double cosine = std::clamp(((given.R.transpose() * estimate.R).trace() - 1.0) / 2.0, -1.0, 1.0);
+  change.rotation_degrees = std::acos(cosine) * 180.0 / M_PI;
+  change.translation = (estimate.t - given.t).norm();
+  return change;
+}
+
+std::vector<InstanceVerdict> ChooseCertified(const GivenPoseSources& matched,
+                                             const std::vector<PoseHypothesis>& poses,
+                                             const CertifyBatchResult& result) {
+  std::map<std::size_t, InstanceVerdict> verdicts;
+  for (std::size_t s = 0; s < matched.sources.size(); ++s) {
+    InstanceVerdict& verdict = verdicts[matched.instance[s]];
+    verdict.instance = matched.instance[s];
+    verdict.sources.push_back(s);
+    const CloudOutcome& outcome = result.outcomes[s];
+    if (!outcome.certified()) continue;
+    if (!verdict.chosen) {
+      verdict.chosen = s;
+      continue;
+    }
+    const CloudOutcome& best = result.outcomes[*verdict.chosen];
+    const double fit = outcome.estimate.certificate.oc.max_point_distance;
+    const double best_fit = best.estimate.certificate.oc.max_point_distance;
+    const double score = poses[matched.hypothesis[s]].score;
+    const double best_score = poses[matched.hypothesis[*verdict.chosen]].score;
+    if (fit < best_fit || (fit == best_fit && score > best_score)) verdict.chosen = s;
+  }
+  std::vector<InstanceVerdict> out;
+  for (auto& [instance, verdict] : verdicts) out.push_back(std::move(verdict));
+  return out;
+}
+
+}  // namespace c3po
