@@ -383,7 +383,14 @@ TEST_CASE("patience stops self-training after epochs without a new best") {
 
 TEST_CASE("mixed unlabelled data: another object's clouds are never pseudo-labels") {
   const ObjectModel object = test::AsymmetricObject(8000);
-  const ObjectModel other = FlatNearSymmetricObject(0.004);
+  // A 12 cm cube: no pose of the asymmetric object explains its clouds
+  // within eps_oc, so the certificate must reject every one of them.
+  ObjectSpec cube_spec;
+  cube_spec.name = "cube12";
+  cube_spec.keypoints = test::BoxMesh({0, 0, 0}, {0.12, 0.12, 0.12}).vertices;
+  cube_spec.eps_oc = 0.01;
+  cube_spec.delta_nd = 0.004;
+  const ObjectModel other(cube_spec, test::BoxMesh({0, 0, 0}, {0.12, 0.12, 0.12}));
   std::vector<PointSet> own = Clouds(object, 24);
   std::vector<PointSet> mixed = own;
   for (const auto& cloud : NoisyClouds(other, 24, 0.0005, 8)) mixed.push_back(cloud);
@@ -392,6 +399,10 @@ TEST_CASE("mixed unlabelled data: another object's clouds are never pseudo-label
   options.epochs = 3;
   SelfTrain(object, mixed, detector, options);
   REQUIRE_FALSE(detector.trained.empty());
+  // And the final detector + corrector certifies none of the cube's clouds.
+  const CertifiedFraction on_other = MeasureCertified(object, std::vector<PointSet>(mixed.begin() + 24, mixed.end()),
+                                                      detector, options.pipeline);
+  CHECK(on_other.percent_oc == 0.0);
   for (const auto& cloud : detector.trained) {
     const bool is_own = std::any_of(own.begin(), own.end(), [&](const PointSet& c) {
       return c.cols() == cloud.cols() && c == cloud;
