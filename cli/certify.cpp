@@ -14,6 +14,11 @@
 #include "c3po/base/error.hpp"
 #include "c3po/io/bop.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/io/pose_list.hpp"
+#include "c3po/io/shard.hpp"
+#include "c3po/method/certify_batch.hpp"
+#include "c3po/method/given_poses.hpp"
+#include "c3po/method/image_sources.hpp"
 #include "c3po/object/object_io.hpp"
 #include "command.hpp"
 #include "options.hpp"
@@ -33,6 +38,13 @@ struct CertifyCommand {
   CorrectorFlags corrector;
   RobustFlags robust;
   bool no_correct = false;
+  // Images (one frame) and BOP datasets (docs/camera_inputs.md).
+  FrameFlags frame;
+  BopFlags bop;
+  SegmentOptions segment;
+  std::string bop_csv_path;
+  std::string shard;
+  std::string poses_path;   // certify given poses (docs/method.md "Certifying given poses")
 };
 
 std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
@@ -177,6 +189,11 @@ int Run(const CertifyCommand& cmd) {
     }
     append(BopSources(listed, cmd.segment));
   }
+  if (sources.empty()) {
+    throw InputError("c3po certify", "no clouds given (CLOUD..., --data DIR, --depth/--mask or --bop DIR)");
+  }
+  if (shard) sources = ShardSources(sources, *shard);
+  if (!cmd.poses_path.empty()) return RunGivenPoses(cmd, object, options, sources);
   LoadPlugins(cmd.detector);
   const std::unique_ptr<Detector> detector =
       MakeDetector(cmd.detector.models.empty() ? "" : cmd.detector.models.front(),

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "c3po/base/error.hpp"
@@ -35,12 +36,12 @@ struct SelftrainCommand {
 };
 
 nlohmann::json EpochJson(const SelfTrainEpochLog& e) {
-  return {{"phase", "selftrain"}, {"epoch", e.epoch}, {"train_percent_oc", e.train_percent_oc},
-          {"validation_percent_oc", e.validation_percent_oc},
-          {"validation_percent_certified", e.validation_percent_certified},
-          {"validation_detection_error", e.validation_detection_error}, {"loss", e.loss},
-          {"mean_corrector_iterations", e.mean_corrector_iterations},
-          {"certified_samples", e.certified_samples}, {"seconds", e.seconds}};
+  nlohmann::json j = nlohmann::json::parse(ToJson(e));
+  j["phase"] = "selftrain";
+  // The ground-truth columns only when the data had ground truth.
+  if (e.validation_rotation_error_median < 0) j.erase("validation_rotation_error_median");
+  if (e.validation_hausdorff_median < 0) j.erase("validation_hausdorff_median");
+  return j;
 }
 
 int Run(SelftrainCommand cmd) {
@@ -71,6 +72,13 @@ int Run(SelftrainCommand cmd) {
   const Dataset dataset = ReadDataset(cmd.data_dir);
   if (dataset.entries.size() < 2) throw InputError(cmd.data_dir, "need at least 2 clouds to self-train");
   const std::vector<PointSet> clouds = LoadDatasetClouds(dataset, "loading");
+  // Ground truth, when the dataset has it, only feeds the log's reporting
+  // columns (rotation error, Hausdorff distance); selection never reads it.
+  std::optional<SelfTrainReference> reference;
+  if (dataset.HasGroundTruth()) {
+    reference.emplace();
+    for (const auto& entry : dataset.entries) reference->scene_from_model.push_back(*entry.pose);
+  }
   std::string eps_oc_evidence;
   if (cmd.thresholds.auto_eps_oc()) {
     // --eps-oc auto (CertifyBatch decides it): from the unlabelled clouds and
@@ -99,13 +107,20 @@ int Run(SelftrainCommand cmd) {
       [&](const SelfTrainEpochLog& e) {
         progress.Finish();
         log.Record(e.epoch, EpochJson(e).dump());
-        std::fprintf(stderr, "epoch %3d  train oc %5.1f%%  val oc %5.1f%%  val certified %5.1f%%  loss %.3e  "
-                     "corrector it %.1f  %.1fs\n",
-                     e.epoch, e.train_percent_oc, e.validation_percent_oc, e.validation_percent_certified, e.loss,
-                     e.mean_corrector_iterations, e.seconds);
+        std::fprintf(stderr, "epoch %3d  train oc %5.1f%% (%d ambiguous skipped)  val oc %5.1f%%  identified %5.1f%%  "
+                     "residual q50 %.3g q90 %.3g  loss %.3e%s%s  %.1fs\n",
+                     e.epoch, e.train_percent_oc, e.ambiguous_skipped, e.validation_percent_oc,
+                     e.validation_percent_identified, e.validation_residual_q50, e.validation_residual_q90, e.loss,
+                     e.rolled_back ? "  ROLLED BACK" : "",
+                     e.validation_hausdorff_median >= 0
+                         ? (" [truth: rot " + std::to_string(e.validation_rotation_error_median) + " deg, hausdorff " +
+                            std::to_string(e.validation_hausdorff_median) + "]").c_str()
+                         : "",
+                     e.seconds);
         progress = ProgressBar("selftrain", 1);
       },
-      [&](std::size_t done, std::size_t total) { progress.Update(total ? done / total : 0); }, cmd.resume);
+      [&](std::size_t done, std::size_t total) { progress.Update(total ? done / total : 0); }, cmd.resume,
+      reference ? &*reference : nullptr);
   progress.Finish();
   nlohmann::json extra = {
       {"selftrained", true},
@@ -115,11 +130,18 @@ int Run(SelftrainCommand cmd) {
                      {"best_epoch", result.best_epoch},
                      {"initial_validation_percent_oc", result.initial_validation_percent_oc},
                      {"best_validation_percent_oc", result.best_validation_percent_oc},
+                     {"initial_validation_percent_identified", result.initial.percent_identified},
+                     {"best_validation_percent_identified", result.best.percent_identified},
+                     {"initial_validation_residual_q50", result.initial.residual_q50},
+                     {"best_validation_residual_q50", result.best.residual_q50},
                      {"stopped_early", result.stopped_early}}}};
   if (!eps_oc_evidence.empty()) extra["selftrain"]["eps_oc_auto"] = nlohmann::json::parse(eps_oc_evidence);
   detector->Save(cmd.output_path, extra.dump());
-  std::printf("wrote %s: validation %% oc %.1f -> %.1f (best epoch %d%s); eps_oc = %.6g; log %s\n",
+  std::printf("wrote %s: validation %% oc %.1f -> %.1f, %% identified %.1f -> %.1f, residual q50 %.3g -> %.3g "
+              "(best epoch %d%s); eps_oc = %.6g; log %s\n",
               cmd.output_path.c_str(), result.initial_validation_percent_oc, result.best_validation_percent_oc,
+              result.initial.percent_identified, result.best.percent_identified, result.initial.residual_q50,
+              result.best.residual_q50,
               result.best_epoch, result.stopped_early ? ", stopped early" : "",
               options.pipeline.certificate.eps_oc, log.path().c_str());
   return 0;
@@ -139,7 +161,15 @@ RunFunction SetupSelftrain(CLI::App& command) {
   command.add_option("--lr", cmd->lr, "Learning rate");
   command.add_option("--optimizer", cmd->optimizer, "adam or sgd");
   command.add_option("--val-fraction", o.validation_fraction, "Held-out fraction of the unlabelled clouds");
-  command.add_option("--stop-at", o.stop_at_percent_oc, "Stop when this % of the held-out clouds is observably correct");
+  command.add_option("--stop-at", o.stop_at_percent_oc,
+                     "Stop when this % of the held-out clouds is identified (observably correct, not ambiguous)");
+  command.add_option("--patience", o.patience, "Stop after this many epochs without a new best (0 = never)");
+  command.add_option("--residual-tolerance", o.residual_tolerance,
+                     "An epoch whose median held-out fit residual rises by more than this fraction is rolled back");
+  command.add_option("--ambiguity-ratio", o.pseudo_labels.residual_ratio,
+                     "A second basin fitting within this factor of the chosen fit's residual makes a sample ambiguous");
+  command.add_flag("!--no-ambiguity-check", o.pseudo_labels.check_ambiguity,
+                   "Train on every certified sample, ambiguous or not (reproduces the flip regression)");
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kAllowed);
   AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);

@@ -249,6 +249,12 @@ check certify_output_unwritable "2" blocker/out.jsonl blocker sim -- "$C3PO" cer
 [ "${C3PO_WITH_POINTNET:-ON}" == OFF ] || check train_output_unwritable "2" blocker/x.model blocker sim -- "$C3PO" train "$CUBE" --data sim -o blocker/x.model --epochs 1 --point-mlp 8 8 --head 8 --points 32
 check synth_output_unwritable "2" blocker/ds blocker "$CUBE" -- "$C3PO" synth "$CUBE" -o blocker/ds --kind sim --count 2 --points 50
 [ "${C3PO_WITH_POINTNET:-ON}" == OFF ] || check train_empty_dataset "2" e.model no_manifest no_manifest -- "$C3PO" train "$CUBE" --data no_manifest -o e.model --epochs 1
+# --- selftrain's selection and ambiguity options (issue 18): out of range => one line naming selftrain
+if [ "${C3PO_WITH_POINTNET:-ON}" != OFF ] && [ -e cube.model ]; then
+  check selftrain_ambiguity_ratio "2" st.model "c3po selftrain" sim cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --data sim -o st.model --ambiguity-ratio 0.5
+  check selftrain_residual_tol "2" st.model "c3po selftrain" sim cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --data sim -o st.model --residual-tolerance nan
+  check selftrain_patience "2" st.model "c3po selftrain" sim cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --data sim -o st.model --patience -1
+fi
 
 echo "failures: $failures"
 [ $failures -eq 0 ]

@@ -8,6 +8,7 @@
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/method/pseudo_label.hpp"
 #include "c3po/method/selftrain.hpp"
 #include "test_helpers.hpp"
 #include "test_objects.hpp"
@@ -77,6 +78,7 @@ SelfTrainOptions Options(const ObjectModel& object) {
   options.batch = 8;
   options.validation_fraction = 0.25;
   options.stop_at_percent_oc = 101;   // never stop early in tests
+  options.patience = 0;
   options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
   options.pipeline.certificate.eps_oc = 0.01;
   return options;
@@ -149,4 +151,262 @@ TEST_CASE("resuming from a checkpoint gives the uninterrupted result") {
   const SelfTrainResult result = SelfTrain(object, clouds, resumed, options, {}, {}, /*resume=*/true);
   CHECK(result.epochs.size() == 4);
   CHECK(resumed.GetWeights() == straight.GetWeights());
+}
+
+namespace {
+
+// A flat slab 0.20 x 0.10 x 0.012 with a small bump (bump_height high) near
+// one end of its top face: exactly two-fold symmetric without the bump, so
+// the half-turns about its principal axes are near-equal fits. Keypoints on
+// the slab's corners and on the bump.
+ObjectModel FlatNearSymmetricObject(double bump_height, int sample_size = 6000) {
+  Mesh mesh = test::MergeMeshes({test::BoxMesh({0, 0, 0}, {0.20, 0.10, 0.012}),
+                                 test::BoxMesh({0.07, 0.02, 0.006 + bump_height / 2},
+                                               {0.012, 0.012, bump_height})});
+  ObjectSpec spec;
+  spec.name = "flat";
+  spec.keypoints.resize(3, 9);
+  spec.keypoints << -0.10, 0.10, 0.10, -0.10, -0.10, 0.10, 0.10, -0.10, 0.07,  //
+      -0.05, -0.05, 0.05, 0.05, -0.05, -0.05, 0.05, 0.05, 0.02,                  //
+      -0.006, -0.006, -0.006, -0.006, 0.006, 0.006, 0.006, 0.006, 0.006 + bump_height;
+  spec.eps_oc = 0.01;
+  spec.delta_nd = 0.004;
+  ObjectModelOptions options;
+  options.sample_size = sample_size;
+  return ObjectModel(spec, mesh, options);
+}
+
+// Clouds of `object` at identity rotation, random translations, noise_sigma
+// Gaussian noise per coordinate; the true poses in *truth.
+std::vector<PointSet> NoisyClouds(const ObjectModel& object, int count, double noise_sigma, std::uint64_t seed,
+                                  std::vector<Pose>* truth = nullptr) {
+  std::vector<PointSet> clouds;
+  Rng rng(seed);
+  for (int i = 0; i < count; ++i) {
+    Pose pose;
+    pose.t = Eigen::Vector3d(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(1, 2));
+    PointSet cloud = pose * SampleSurface(object.mesh(), 300, seed * 1000 + i);
+    for (Eigen::Index j = 0; j < cloud.size(); ++j) cloud.data()[j] += noise_sigma * rng.Normal();
+    clouds.push_back(cloud);
+    if (truth) truth->push_back(pose);
+  }
+  return clouds;
+}
+
+Eigen::Matrix3d RotationZ(double degrees) {
+  return Eigen::AngleAxisd(degrees * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+// The keypoint offsets of a detector that is `degrees` off about z (model frame).
+PointSet TurnedKeypoints(const ObjectModel& object, double degrees) {
+  return RotationZ(degrees) * CentredKeypoints(object);
+}
+
+// Records every cloud it is trained on.
+class RecordingDetector : public OffsetDetector {
+ public:
+  using OffsetDetector::OffsetDetector;
+  double TrainStep(const std::vector<PointSet>& clouds, const std::vector<PointSet>& targets) override {
+    trained.insert(trained.end(), clouds.begin(), clouds.end());
+    return OffsetDetector::TrainStep(clouds, targets);
+  }
+  std::vector<PointSet> trained;
+};
+
+// Adds `damage` to every offset after its sabotage_step-th training step.
+class SabotagedDetector : public OffsetDetector {
+ public:
+  SabotagedDetector(PointSet offsets, double lr, int sabotage_step, Eigen::Vector3d damage)
+      : OffsetDetector(std::move(offsets), lr), sabotage_step_(sabotage_step), damage_(std::move(damage)) {}
+  double TrainStep(const std::vector<PointSet>& clouds, const std::vector<PointSet>& targets) override {
+    const double loss = OffsetDetector::TrainStep(clouds, targets);
+    if (++steps_ == sabotage_step_) {
+      std::vector<float> w = GetWeights();
+      for (std::size_t i = 0; i < w.size(); ++i) w[i] += static_cast<float>(damage_[static_cast<int>(i % 3)]);
+      SetWeights(w);
+    }
+    return loss;
+  }
+
+ private:
+  int sabotage_step_;
+  Eigen::Vector3d damage_;
+  int steps_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("pseudo-label check: a flat near-symmetric object's flip is ambiguous, an asymmetric object's is not") {
+  // Oracle: the true pose, corrected from the true keypoints; the half-turn
+  // about the slab's normal moves the keypoints by ~0.2 m, and the flipped
+  // slab explains the cloud within eps_oc = 1 cm (the bump is 4 mm).
+  const ObjectModel flat = FlatNearSymmetricObject(0.004);
+  const ObjectModel asym = test::AsymmetricObject(6000);
+  for (const ObjectModel* object : {&flat, &asym}) {
+    std::vector<Pose> truth;
+    const auto clouds = NoisyClouds(*object, 3, 0.0005, 21, &truth);
+    PipelineOptions pipeline;
+    pipeline.certificate = CertificateOptions::FromObject(object->spec());
+    pipeline.certificate.eps_oc = 0.01;
+    const PrincipalFrame frame = ModelPrincipalFrame(*object);
+    for (std::size_t i = 0; i < clouds.size(); ++i) {
+      const PoseEstimate estimate = EstimateAndCertify(*object, clouds[i], truth[i] * object->keypoints(), pipeline);
+      REQUIRE(estimate.certificate.oc.passed);
+      const PseudoLabelCheck check = CheckPseudoLabel(*object, clouds[i], estimate, pipeline, {}, frame);
+      CAPTURE(object->name());
+      CHECK(check.ambiguous == (object == &flat));
+      if (object == &flat) {
+        CHECK(check.rival_passes_oc);
+        CHECK(check.rival_keypoint_distance > 0.1);
+      }
+      // Switched off: never ambiguous, the residual still measured.
+      PseudoLabelOptions off;
+      off.check_ambiguity = false;
+      const PseudoLabelCheck unchecked = CheckPseudoLabel(*object, clouds[i], estimate, pipeline, off, frame);
+      CHECK_FALSE(unchecked.ambiguous);
+      CHECK(unchecked.residual == doctest::Approx(check.residual));
+    }
+  }
+  // The half-turn about axis 2 (the slab's normal) maps the exactly symmetric
+  // part onto itself: an independent check of the principal frame.
+  const PrincipalFrame frame = ModelPrincipalFrame(flat);
+  CHECK(std::abs(frame.axes.col(2).z()) > 0.99);
+  CHECK(std::abs(frame.axes.col(0).x()) > 0.99);
+  const Pose flip = HalfTurn(frame, 2);
+  CHECK((flip * flip).R.isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+  CHECK((flip * frame.centroid - frame.centroid).norm() < 1e-12);
+}
+
+TEST_CASE("self-training on a flat near-symmetric object: the flip is learnt without the ambiguity rule, refused with it") {
+  const ObjectModel object = FlatNearSymmetricObject(0.004);
+  std::vector<Pose> truth;
+  const auto clouds = NoisyClouds(object, 32, 0.0005, 5, &truth);
+  const SelfTrainReference reference{truth};
+  SelfTrainOptions options = Options(object);
+  options.epochs = 6;
+  // The detector starts 150 degrees off about the normal: nearer the flipped
+  // basin, where the corrector lands and the 1 cm certificate passes.
+  const PointSet start = TurnedKeypoints(object, 150.0);
+  const PointSet flipped = TurnedKeypoints(object, 180.0);
+  const PointSet correct = CentredKeypoints(object);
+
+  // Mechanism: without the rule every certified sample teaches the flip;
+  // validation % oc stays at 100 and the old oc-only criterion sees nothing.
+  OffsetDetector naive(start, 0.5);
+  SelfTrainOptions naive_options = options;
+  naive_options.pseudo_labels.check_ambiguity = false;
+  const SelfTrainResult naive_result = SelfTrain(object, clouds, naive, naive_options, {}, {}, false, &reference);
+  const PointSet naive_offsets = naive.Detect(PointSet::Zero(3, 1));
+  CHECK((naive_offsets - flipped).norm() < 0.2 * (naive_offsets - correct).norm());
+  CHECK(naive_result.initial.percent_oc == 100.0);
+  CHECK(naive_result.best.percent_oc == 100.0);
+  CHECK(naive_result.best.rotation_error_median > 170.0);   // reporting: the flip
+
+  // With the rule: the samples are refused as ambiguous and the detector is
+  // not moved toward the flip.
+  OffsetDetector careful(start, 0.5);
+  const SelfTrainResult careful_result = SelfTrain(object, clouds, careful, options, {}, {}, false, &reference);
+  for (const auto& log : careful_result.epochs) {
+    CHECK(log.certified_samples > 0);
+    CHECK(log.ambiguous_skipped == log.certified_samples);
+    CHECK(log.validation_percent_identified == 0.0);
+  }
+  CHECK(careful.Detect(PointSet::Zero(3, 1)).isApprox(start, 1e-6));
+
+  // From near the correct mode the rule also refuses (the certificate cannot
+  // tell the modes apart at 1 cm), so the detector stays there.
+  OffsetDetector near_correct(TurnedKeypoints(object, 20.0), 0.5);
+  SelfTrain(object, clouds, near_correct, options);
+  const PointSet after = near_correct.Detect(PointSet::Zero(3, 1));
+  CHECK((after - correct).norm() < (after - flipped).norm());
+}
+
+TEST_CASE("self-training keeps the correct mode when the certificate separates the flip") {
+  // A 2.5 cm bump: the flipped slab leaves points 2.5 cm from the model, so
+  // the flip fails the 1 cm certificate and the samples are not ambiguous.
+  const ObjectModel object = FlatNearSymmetricObject(0.025);
+  std::vector<Pose> truth;
+  const auto clouds = NoisyClouds(object, 32, 0.0005, 6, &truth);
+  const SelfTrainReference reference{truth};
+  SelfTrainOptions options = Options(object);
+  options.epochs = 6;
+  OffsetDetector detector(TurnedKeypoints(object, 20.0), 0.5);
+  const SelfTrainResult result = SelfTrain(object, clouds, detector, options, {}, {}, false, &reference);
+  CHECK(result.epochs.front().ambiguous_skipped == 0);
+  CHECK(result.best.rotation_error_median < 1.0);
+  const PointSet after = detector.Detect(PointSet::Zero(3, 1));
+  CHECK((after - CentredKeypoints(object)).norm() < (TurnedKeypoints(object, 20.0) - CentredKeypoints(object)).norm());
+}
+
+TEST_CASE("epoch selection rolls back a deliberately bad epoch") {
+  const ObjectModel object = test::AsymmetricObject(8000);
+  const auto clouds = Clouds(object, 40);
+  SelfTrainOptions options = Options(object);
+  options.epochs = 5;
+  const int steps_per_epoch = (40 - 10 + options.batch - 1) / options.batch;   // 30 training clouds
+  // After the last step of epoch 3 every keypoint is thrown 5 cm off: the
+  // corrector still rescues the held-out clouds, but the detected keypoints
+  // now disagree with their corrections by ~7 cm (the label-free agreement
+  // criterion).
+  SabotagedDetector detector(CentredKeypoints(object).colwise() + Eigen::Vector3d(0.02, 0.0, 0.01), 0.5,
+                             3 * steps_per_epoch, Eigen::Vector3d(0.05, 0.05, 0.0));
+  const SelfTrainResult result = SelfTrain(object, clouds, detector, options);
+  REQUIRE(result.epochs.size() == 5);
+  CHECK(result.epochs[2].rolled_back);
+  CHECK(result.epochs[2].validation_detection_error > 0.05);
+  CHECK(result.best.detection_error < 0.01);
+  CHECK(result.best_epoch != 3);
+  CHECK_FALSE(result.epochs[0].rolled_back);
+  // Training continued from the best weights: epoch 4 agrees again.
+  CHECK_FALSE(result.epochs[3].rolled_back);
+  CHECK(result.epochs[3].validation_detection_error < 0.01);
+  // The returned detector holds the best weights, not the sabotaged ones.
+  const CertifiedFraction final_fit = MeasureCertified(object, clouds, detector, options.pipeline);
+  CHECK(final_fit.percent_oc == 100.0);
+  CHECK(final_fit.detection_error < 0.01);
+}
+
+TEST_CASE("patience stops self-training after epochs without a new best") {
+  const ObjectModel object = test::AsymmetricObject(8000);
+  const auto clouds = Clouds(object, 24);
+  SelfTrainOptions options = Options(object);
+  options.epochs = 20;
+  options.patience = 2;
+  // A detector that cannot learn (zero step): every epoch equals the initial
+  // model, so none is a new best and the run stops after `patience` epochs.
+  OffsetDetector detector(CentredKeypoints(object).colwise() + Eigen::Vector3d(0.01, 0.0, 0.0), 0.0);
+  const SelfTrainResult result = SelfTrain(object, clouds, detector, options);
+  CHECK(result.stopped_early);
+  CHECK(result.epochs.size() == 2);
+  CHECK(result.best_epoch == 0);
+}
+
+TEST_CASE("mixed unlabelled data: another object's clouds are never pseudo-labels") {
+  const ObjectModel object = test::AsymmetricObject(8000);
+  // A 12 cm cube: no pose of the asymmetric object explains its clouds
+  // within eps_oc, so the certificate must reject every one of them.
+  ObjectSpec cube_spec;
+  cube_spec.name = "cube12";
+  cube_spec.keypoints = test::BoxMesh({0, 0, 0}, {0.12, 0.12, 0.12}).vertices;
+  cube_spec.eps_oc = 0.01;
+  cube_spec.delta_nd = 0.004;
+  const ObjectModel other(cube_spec, test::BoxMesh({0, 0, 0}, {0.12, 0.12, 0.12}));
+  std::vector<PointSet> own = Clouds(object, 24);
+  std::vector<PointSet> mixed = own;
+  for (const auto& cloud : NoisyClouds(other, 24, 0.0005, 8)) mixed.push_back(cloud);
+  RecordingDetector detector(CentredKeypoints(object).colwise() + Eigen::Vector3d(0.02, 0.0, 0.01), 0.5);
+  SelfTrainOptions options = Options(object);
+  options.epochs = 3;
+  SelfTrain(object, mixed, detector, options);
+  REQUIRE_FALSE(detector.trained.empty());
+  // And the final detector + corrector certifies none of the cube's clouds.
+  const CertifiedFraction on_other = MeasureCertified(object, std::vector<PointSet>(mixed.begin() + 24, mixed.end()),
+                                                      detector, options.pipeline);
+  CHECK(on_other.percent_oc == 0.0);
+  for (const auto& cloud : detector.trained) {
+    const bool is_own = std::any_of(own.begin(), own.end(), [&](const PointSet& c) {
+      return c.cols() == cloud.cols() && c == cloud;
+    });
+    CHECK(is_own);
+  }
 }

@@ -16,6 +16,7 @@
 #include "c3po/base/interrupt.hpp"
 #include "c3po/base/parallel.hpp"
 #include "c3po/base/random.hpp"
+#include "c3po/geometry/distances.hpp"
 
 namespace c3po {
 
@@ -25,6 +26,11 @@ void SelfTrainOptions::Check() const {
   if (!(validation_fraction > 0 && validation_fraction < 1)) {
     throw std::invalid_argument("validation fraction must be in (0, 1)");
   }
+  if (!(residual_tolerance >= 0 && std::isfinite(residual_tolerance))) {
+    throw std::invalid_argument("residual tolerance must be >= 0");
+  }
+  if (patience < 0) throw std::invalid_argument("patience must be >= 0");
+  pseudo_labels.Check();
   pipeline.Check();
 }
 
@@ -65,6 +71,73 @@ CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<
 
 namespace {
 
+// Linear-interpolation quantile; 0 for no values.
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double position = q * static_cast<double>(values.size() - 1);
+  const auto below = static_cast<std::size_t>(std::floor(position));
+  const std::size_t above = std::min(values.size() - 1, below + 1);
+  return values[below] + (position - static_cast<double>(below)) * (values[above] - values[below]);
+}
+
+double RotationAngleDegrees(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  const double cosine = std::clamp(((a.transpose() * b).trace() - 1.0) / 2.0, -1.0, 1.0);
+  return std::acos(cosine) * 180.0 / M_PI;
+}
+
+}  // namespace
+
+ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<PointSet>& clouds,
+                                   const Detector& detector, const PipelineOptions& pipeline,
+                                   const PseudoLabelOptions& pseudo_labels, const std::vector<Pose>* truth) {
+  ValidationFit fit;
+  if (clouds.empty()) return fit;
+  const CertifiedFraction measured = MeasureCertified(object, clouds, detector, pipeline);
+  fit.percent_oc = measured.percent_oc;
+  fit.percent_certified = measured.percent_certified;
+  fit.detection_error = measured.detection_error;
+  const PrincipalFrame frame = ModelPrincipalFrame(object);
+  std::vector<double> residuals;
+  std::vector<char> identified(clouds.size(), 0), ambiguous(clouds.size(), 0);
+  ParallelFor(0, static_cast<int>(clouds.size()), [&](int i) {
+    const PoseEstimate& e = measured.estimates[i];
+    if (!e.ok()) return;
+    PseudoLabelOptions options = pseudo_labels;
+    options.check_ambiguity = pseudo_labels.check_ambiguity && e.certificate.oc.passed;
+    const PseudoLabelCheck check = CheckPseudoLabel(object, clouds[i], e, pipeline, options, frame);
+    ambiguous[i] = check.ambiguous;
+    identified[i] = e.certificate.oc.passed && !check.ambiguous;
+  });
+  for (std::size_t i = 0; i < clouds.size(); ++i) {
+    if (measured.estimates[i].ok()) {
+      residuals.push_back(FitResidual(object, clouds[i], measured.estimates[i].scene_from_model));
+    }
+    fit.ambiguous += ambiguous[i];
+    fit.percent_identified += identified[i];
+  }
+  fit.percent_identified *= 100.0 / static_cast<double>(clouds.size());
+  fit.residual_q50 = Quantile(residuals, 0.5);
+  fit.residual_q90 = Quantile(residuals, 0.9);
+  if (truth != nullptr && truth->size() == clouds.size()) {
+    // At most ~500 model points, evenly strided.
+    const Eigen::Index stride = std::max<Eigen::Index>(1, object.sample().cols() / 500);
+    PointSet model(3, (object.sample().cols() + stride - 1) / stride);
+    for (Eigen::Index j = 0; j < model.cols(); ++j) model.col(j) = object.sample().col(j * stride);
+    std::vector<double> rotation, hausdorff;
+    for (std::size_t i = 0; i < clouds.size(); ++i) {
+      const Pose& estimate = measured.estimates[i].scene_from_model;
+      rotation.push_back(RotationAngleDegrees((*truth)[i].R, estimate.R));
+      hausdorff.push_back(HausdorffDistance((*truth)[i] * model, estimate * model));
+    }
+    fit.rotation_error_median = Quantile(rotation, 0.5);
+    fit.hausdorff_median = Quantile(hausdorff, 0.5);
+  }
+  return fit;
+}
+
+namespace {
+
 using nlohmann::json;
 
 std::vector<int> Shuffled(std::vector<int> indices, Rng rng) {
@@ -74,27 +147,49 @@ std::vector<int> Shuffled(std::vector<int> indices, Rng rng) {
   return indices;
 }
 
+#define C3PO_SELFTRAIN_LOG_FIELDS(X)                                                          \
+  X(epoch) X(train_percent_oc) X(validation_percent_oc) X(validation_percent_certified)      \
+  X(validation_detection_error) X(loss) X(mean_corrector_iterations) X(certified_samples)   \
+  X(ambiguous_skipped) X(validation_percent_identified) X(validation_ambiguous)             \
+  X(validation_residual_q50) X(validation_residual_q90) X(rolled_back)                      \
+  X(validation_rotation_error_median) X(validation_hausdorff_median) X(seconds)
+
 json LogJson(const SelfTrainEpochLog& log) {
-  return {{"epoch", log.epoch}, {"train_percent_oc", log.train_percent_oc},
-          {"validation_percent_oc", log.validation_percent_oc},
-          {"validation_percent_certified", log.validation_percent_certified},
-          {"validation_detection_error", log.validation_detection_error}, {"loss", log.loss},
-          {"mean_corrector_iterations", log.mean_corrector_iterations},
-          {"certified_samples", log.certified_samples}, {"seconds", log.seconds}};
+  json j;
+#define C3PO_WRITE(field) j[#field] = log.field;
+  C3PO_SELFTRAIN_LOG_FIELDS(C3PO_WRITE)
+#undef C3PO_WRITE
+  return j;
 }
 
 SelfTrainEpochLog LogFromJson(const json& j) {
   SelfTrainEpochLog log;
-  log.epoch = j.at("epoch");
-  log.train_percent_oc = j.at("train_percent_oc");
-  log.validation_percent_oc = j.at("validation_percent_oc");
-  log.validation_percent_certified = j.at("validation_percent_certified");
-  log.validation_detection_error = j.at("validation_detection_error");
-  log.loss = j.at("loss");
-  log.mean_corrector_iterations = j.at("mean_corrector_iterations");
-  log.certified_samples = j.at("certified_samples");
-  log.seconds = j.at("seconds");
+#define C3PO_READ(field) j.at(#field).get_to(log.field);
+  C3PO_SELFTRAIN_LOG_FIELDS(C3PO_READ)
+#undef C3PO_READ
   return log;
+}
+
+json FitJson(const ValidationFit& f) {
+  return {{"percent_oc", f.percent_oc}, {"percent_certified", f.percent_certified},
+          {"percent_identified", f.percent_identified}, {"ambiguous", f.ambiguous},
+          {"detection_error", f.detection_error}, {"residual_q50", f.residual_q50},
+          {"residual_q90", f.residual_q90}, {"rotation_error_median", f.rotation_error_median},
+          {"hausdorff_median", f.hausdorff_median}};
+}
+
+ValidationFit FitFromJson(const json& j) {
+  ValidationFit f;
+  j.at("percent_oc").get_to(f.percent_oc);
+  j.at("percent_certified").get_to(f.percent_certified);
+  j.at("percent_identified").get_to(f.percent_identified);
+  j.at("ambiguous").get_to(f.ambiguous);
+  j.at("detection_error").get_to(f.detection_error);
+  j.at("residual_q50").get_to(f.residual_q50);
+  j.at("residual_q90").get_to(f.residual_q90);
+  j.at("rotation_error_median").get_to(f.rotation_error_median);
+  j.at("hausdorff_median").get_to(f.hausdorff_median);
+  return f;
 }
 
 // The best weights live beside the checkpoint as raw floats.
@@ -118,6 +213,7 @@ struct EpochStats {
   int steps = 0;
   int certified = 0;
   int seen = 0;
+  int ambiguous = 0;
   double iterations = 0.0;
 };
 
@@ -128,6 +224,7 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
                     const SelfTrainOptions& options, const ProgressCallback& progress,
                     std::size_t progress_offset, std::size_t progress_total, int epoch) {
   EpochStats stats;
+  const PrincipalFrame frame = ModelPrincipalFrame(object);
   for (std::size_t start = 0; start < order.size(); start += options.batch) {
     HoldForInterruptAt(epoch, static_cast<long long>(start / options.batch));
     ThrowIfInterrupted();
@@ -135,16 +232,26 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
     std::vector<PointSet> batch;
     for (std::size_t k = start; k < end; ++k) batch.push_back(clouds[order[k]]);
     const std::vector<PoseEstimate> estimates = MeasureCertified(object, batch, detector, options.pipeline).estimates;
+    // Ambiguous pseudo-labels (pseudo_label.hpp) are refused.
+    std::vector<char> usable(batch.size(), 0), ambiguous(batch.size(), 0);
+    ParallelFor(0, static_cast<int>(batch.size()), [&](int i) {
+      if (!estimates[i].ok() || !estimates[i].certificate.oc.passed) return;
+      const PseudoLabelCheck check =
+          CheckPseudoLabel(object, batch[i], estimates[i], options.pipeline, options.pseudo_labels, frame);
+      ambiguous[i] = check.ambiguous;
+      usable[i] = !check.ambiguous;
+    });
     std::vector<PointSet> certified_clouds, targets;
     for (std::size_t i = 0; i < batch.size(); ++i) {
       stats.iterations += estimates[i].correction.iterations;
-      if (estimates[i].ok() && estimates[i].certificate.oc.passed) {
+      stats.certified += estimates[i].ok() && estimates[i].certificate.oc.passed;
+      stats.ambiguous += ambiguous[i];
+      if (usable[i]) {
         certified_clouds.push_back(batch[i]);
         targets.push_back(estimates[i].keypoints);   // pseudo-label: corrected keypoints
       }
     }
     stats.seen += static_cast<int>(batch.size());
-    stats.certified += static_cast<int>(certified_clouds.size());
     if (!certified_clouds.empty()) {
       stats.loss_sum += detector.TrainStep(certified_clouds, targets);
       ++stats.steps;
@@ -156,12 +263,39 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
 
 }  // namespace
 
+std::string ToJson(const SelfTrainEpochLog& log) { return LogJson(log).dump(); }
+
+namespace {
+
+// Label-free comparison of a validation fit against the best so far
+// (method.md "Self-training: epoch selection"). Worse: fewer identified
+// clouds, or the median fit residual up by more than the tolerance, or the
+// detected keypoints far further from their corrections (the detector's
+// agreement with its own pseudo-labels) than the best epoch's. Better: not
+// worse, and more identified clouds, or as many with better agreement.
+bool Worse(const ValidationFit& candidate, const ValidationFit& best, double residual_tolerance, double eps_oc) {
+  return candidate.percent_identified < best.percent_identified ||
+         candidate.residual_q50 > best.residual_q50 * (1.0 + residual_tolerance) ||
+         candidate.detection_error > 1.5 * best.detection_error + 0.1 * eps_oc;
+}
+bool Better(const ValidationFit& candidate, const ValidationFit& best, double residual_tolerance, double eps_oc) {
+  if (Worse(candidate, best, residual_tolerance, eps_oc)) return false;
+  if (candidate.percent_identified != best.percent_identified) return true;
+  if (candidate.detection_error != best.detection_error) return candidate.detection_error < best.detection_error;
+  return candidate.residual_q50 < best.residual_q50;
+}
+
+}  // namespace
+
 SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
                           TrainableDetector& detector, const SelfTrainOptions& options,
                           const EpochCallback& on_epoch, const ProgressCallback& progress,
-                          bool resume) {
+                          bool resume, const SelfTrainReference* reference) {
   options.Check();
   if (clouds.size() < 2) throw InputError("selftrain", "need at least 2 unlabelled clouds");
+  if (reference != nullptr && reference->scene_from_model.size() != clouds.size()) {
+    throw std::invalid_argument("SelfTrain: reference poses must match the clouds");
+  }
   // Deterministic split: a seeded shuffle, the first part held out.
   std::vector<int> all(clouds.size());
   std::iota(all.begin(), all.end(), 0);
@@ -169,12 +303,21 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   const std::size_t validation_count = std::clamp<std::size_t>(
       static_cast<std::size_t>(std::lround(options.validation_fraction * clouds.size())), 1, clouds.size() - 1);
   std::vector<PointSet> validation;
-  for (std::size_t k = 0; k < validation_count; ++k) validation.push_back(clouds[all[k]]);
+  std::vector<Pose> validation_truth;
+  for (std::size_t k = 0; k < validation_count; ++k) {
+    validation.push_back(clouds[all[k]]);
+    if (reference != nullptr) validation_truth.push_back(reference->scene_from_model[all[k]]);
+  }
+  const std::vector<Pose>* truth = reference != nullptr ? &validation_truth : nullptr;
   const std::vector<int> train(all.begin() + static_cast<long>(validation_count), all.end());
+  const auto measure = [&] {
+    return MeasureValidationFit(object, validation, detector, options.pipeline, options.pseudo_labels, truth);
+  };
 
   SelfTrainResult result;
   std::vector<float> best_weights;
   int first_epoch = 1;
+  int stale = 0;   // epochs in a row without a new best
   const std::string best_path = options.checkpoint_path + ".best";
   if (resume && !options.checkpoint_path.empty() && std::filesystem::exists(options.checkpoint_path)) {
     const json state = json::parse(detector.LoadCheckpoint(options.checkpoint_path));
@@ -183,20 +326,26 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     result.best_validation_percent_oc = state.at("best_validation_percent_oc");
     result.best_validation_detection_error = state.at("best_validation_detection_error");
     result.initial_validation_percent_oc = state.at("initial_validation_percent_oc");
+    result.initial = FitFromJson(state.at("initial"));
+    result.best = FitFromJson(state.at("best"));
+    stale = state.at("stale");
     for (const auto& log : state.at("logs")) result.epochs.push_back(LogFromJson(log));
     best_weights = LoadWeights(best_path, detector.GetWeights().size());
   } else {
-    const CertifiedFraction initial = MeasureCertified(object, validation, detector, options.pipeline);
-    result.initial_validation_percent_oc = initial.percent_oc;
-    result.best_validation_percent_oc = initial.percent_oc;
-    result.best_validation_detection_error = initial.detection_error;
+    result.initial = measure();
+    result.best = result.initial;
+    result.initial_validation_percent_oc = result.initial.percent_oc;
+    result.best_validation_percent_oc = result.initial.percent_oc;
+    result.best_validation_detection_error = result.initial.detection_error;
     best_weights = detector.GetWeights();
   }
 
+  const double eps_oc = options.pipeline.certificate.eps_oc;
   const std::size_t progress_total = train.size() * static_cast<std::size_t>(options.epochs);
   for (int epoch = first_epoch; epoch <= options.epochs; ++epoch) {
     if (!result.epochs.empty() &&
-        result.epochs.back().validation_percent_oc >= options.stop_at_percent_oc) {
+        (result.best.percent_identified >= options.stop_at_percent_oc ||
+         (options.patience > 0 && stale >= options.patience))) {
       result.stopped_early = true;
       break;
     }
@@ -204,7 +353,11 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     const std::vector<int> order = Shuffled(train, Rng::ForItem(options.seed, epoch));
     const EpochStats stats = RunEpoch(object, clouds, order, detector, options, progress,
                                       train.size() * (epoch - 1), progress_total, epoch);
-    const CertifiedFraction held_out = MeasureCertified(object, validation, detector, options.pipeline);
+    if (epoch == 1 && stats.certified == 0) {
+      throw InputError("selftrain", "no training cloud was observably correct in the first epoch: nothing to "
+                                    "learn from (check eps_oc, the object, or train the detector on sim data first)");
+    }
+    const ValidationFit held_out = measure();
     SelfTrainEpochLog log;
     log.epoch = epoch;
     log.train_percent_oc = stats.seen ? 100.0 * stats.certified / stats.seen : 0.0;
@@ -214,35 +367,41 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     log.loss = stats.steps ? stats.loss_sum / stats.steps : 0.0;
     log.mean_corrector_iterations = stats.seen ? stats.iterations / stats.seen : 0.0;
     log.certified_samples = stats.certified;
-    log.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (epoch == 1 && stats.certified == 0) {
-      throw InputError("selftrain", "no training cloud was observably correct in the first epoch: nothing to "
-                                    "learn from (check eps_oc, the object, or train the detector on sim data first)");
-    }
-    const bool better = log.validation_percent_oc > result.best_validation_percent_oc ||
-                        (log.validation_percent_oc == result.best_validation_percent_oc &&
-                         log.validation_detection_error < result.best_validation_detection_error);
-    if (better) {
-      result.best_validation_percent_oc = log.validation_percent_oc;
-      result.best_validation_detection_error = log.validation_detection_error;
+    log.ambiguous_skipped = stats.ambiguous;
+    log.validation_percent_identified = held_out.percent_identified;
+    log.validation_ambiguous = held_out.ambiguous;
+    log.validation_residual_q50 = held_out.residual_q50;
+    log.validation_residual_q90 = held_out.residual_q90;
+    log.validation_rotation_error_median = held_out.rotation_error_median;
+    log.validation_hausdorff_median = held_out.hausdorff_median;
+    if (Better(held_out, result.best, options.residual_tolerance, eps_oc)) {
+      result.best = held_out;
+      result.best_validation_percent_oc = held_out.percent_oc;
+      result.best_validation_detection_error = held_out.detection_error;
       result.best_epoch = epoch;
       best_weights = detector.GetWeights();
+      stale = 0;
+    } else {
+      ++stale;
+      if (Worse(held_out, result.best, options.residual_tolerance, eps_oc)) {
+        detector.SetWeights(best_weights);   // roll back: continue from the best epoch
+        log.rolled_back = true;
+      }
     }
+    log.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.epochs.push_back(log);
     if (!options.checkpoint_path.empty()) {
       json state = {{"epoch", epoch}, {"best_epoch", result.best_epoch},
                     {"best_validation_percent_oc", result.best_validation_percent_oc},
                     {"best_validation_detection_error", result.best_validation_detection_error},
                     {"initial_validation_percent_oc", result.initial_validation_percent_oc},
+                    {"initial", FitJson(result.initial)}, {"best", FitJson(result.best)}, {"stale", stale},
                     {"logs", json::array()}};
       for (const auto& l : result.epochs) state["logs"].push_back(LogJson(l));
       SaveWeights(best_path, best_weights);
       detector.SaveCheckpoint(options.checkpoint_path, state.dump());
     }
     if (on_epoch) on_epoch(log);
-  }
-  if (!result.epochs.empty() && result.epochs.back().validation_percent_oc >= options.stop_at_percent_oc) {
-    result.stopped_early = result.epochs.back().epoch < options.epochs;
   }
   detector.SetWeights(best_weights);
   return result;

@@ -183,8 +183,11 @@ std::string AddsPlotsHtml(const Evaluation& e) {
   return out.str();
 }
 
+// Losses, errors, and self-training's fit residual quantiles and Hausdorff
+// distances (one chart; log scale when the ranges differ).
 bool IsLossField(const std::string& name) {
-  return name.find("loss") != std::string::npos || name.find("error") != std::string::npos;
+  return name.find("loss") != std::string::npos || name.find("error") != std::string::npos ||
+         name.find("residual") != std::string::npos || name.find("hausdorff") != std::string::npos;
 }
 bool EndsWith(const std::string& name, const std::string& suffix) {
   return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;

@@ -15,6 +15,7 @@
 #include "c3po/method/certify_batch.hpp"
 #include "c3po/method/detector.hpp"
 #include "c3po/method/pipeline.hpp"
+#include "c3po/method/pseudo_label.hpp"
 #include "c3po/object/object_model.hpp"
 
 namespace c3po {
@@ -23,7 +24,16 @@ struct SelfTrainOptions {
   int epochs = 20;
   int batch = 32;
   double validation_fraction = 0.1;   // held-out part of the unlabelled clouds
-  double stop_at_percent_oc = 99.0;   // early stop on validation % oc
+  double stop_at_percent_oc = 99.0;   // early stop on validation % identified (oc and unambiguous)
+  // Label-free epoch selection (method.md "Self-training"): an epoch is
+  // worse than the best one when its validation % identified drops, its
+  // median fit residual rises by more than residual_tolerance (relative), or
+  // the RMS distance between detected and corrected keypoints exceeds 1.5x
+  // the best's + eps_oc/10; a worse epoch is rolled back (the best weights restored). Training stops
+  // after `patience` epochs in a row without a new best (0 = never).
+  double residual_tolerance = 0.05;
+  int patience = 3;
+  PseudoLabelOptions pseudo_labels;   // refuse ambiguous pseudo-labels (pseudo_label.hpp)
   PipelineOptions pipeline;           // corrector + certificate thresholds
   std::uint64_t seed = 0;
   std::string checkpoint_path;        // written atomically after every epoch ("" = none)
@@ -39,7 +49,32 @@ struct SelfTrainEpochLog {
   double loss = 0.0;                  // mean regression loss on certified samples
   double mean_corrector_iterations = 0.0;
   int certified_samples = 0;
+  int ambiguous_skipped = 0;          // certified training samples refused as ambiguous
+  // Label-free validation criteria.
+  double validation_percent_identified = 0.0;  // oc and not ambiguous
+  int validation_ambiguous = 0;
+  double validation_residual_q50 = 0.0;        // RMS fit residual quantiles over the validation clouds
+  double validation_residual_q90 = 0.0;
+  bool rolled_back = false;                    // worse than the best: the best weights were restored
+  // Reporting only, when ground truth was given (never used for selection);
+  // -1 = none. Rotation error in degrees; Hausdorff distance between the model
+  // posed at the truth and at the estimate (object units).
+  double validation_rotation_error_median = -1.0;
+  double validation_hausdorff_median = -1.0;
   double seconds = 0.0;
+};
+
+// The label-free validation evaluation (also of the initial model).
+struct ValidationFit {
+  double percent_oc = 0.0;
+  double percent_certified = 0.0;
+  double percent_identified = 0.0;
+  int ambiguous = 0;
+  double detection_error = 0.0;
+  double residual_q50 = 0.0;
+  double residual_q90 = 0.0;
+  double rotation_error_median = -1.0;
+  double hausdorff_median = -1.0;
 };
 
 struct SelfTrainResult {
@@ -48,8 +83,19 @@ struct SelfTrainResult {
   double best_validation_percent_oc = 0.0;
   double best_validation_detection_error = 0.0;
   double initial_validation_percent_oc = 0.0;
+  ValidationFit initial;              // the model before self-training
+  ValidationFit best;                 // the kept model
   bool stopped_early = false;
 };
+
+// Optional ground truth for reporting (same length as the clouds); selection
+// never reads it.
+struct SelfTrainReference {
+  std::vector<Pose> scene_from_model;
+};
+
+// One JSON object with every field of the log (the CLI's epoch-log line).
+std::string ToJson(const SelfTrainEpochLog& log);
 
 using EpochCallback = std::function<void(const SelfTrainEpochLog&)>;
 
@@ -59,7 +105,14 @@ using EpochCallback = std::function<void(const SelfTrainEpochLog&)>;
 SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
                           TrainableDetector& detector, const SelfTrainOptions& options,
                           const EpochCallback& on_epoch = {}, const ProgressCallback& progress = {},
-                          bool resume = false);
+                          bool resume = false, const SelfTrainReference* reference = nullptr);
+
+// The validation criteria of `detector` on `clouds` (truth optional, for the
+// reporting fields).
+ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<PointSet>& clouds,
+                                   const Detector& detector, const PipelineOptions& pipeline,
+                                   const PseudoLabelOptions& pseudo_labels,
+                                   const std::vector<Pose>* truth = nullptr);
 
 // % of clouds whose detector + corrector output is observably correct, and %
 // certified (oc and nd); optionally the mean corrector iterations.
