@@ -17,5 +17,5 @@ OBJECT="$SRC/annotations/mug.json"
   || { cat table.txt; echo "FAIL: c3po eval"; exit 1; }
 [ -s report.html ] || { echo "FAIL: report.html not written"; exit 1; }
 
-# KeyPo, + ICP, + corrector for the one detector.
-node "$SRC/tests/browser/report_page.mjs" "$PW_DIR" report.html 3 "$WORK/chromium-profile"
+# KeyPo, + ICP, + RANSAC + ICP, + corrector for the one detector.
+node "$SRC/tests/browser/report_page.mjs" "$PW_DIR" report.html 4 "$WORK/chromium-profile"
