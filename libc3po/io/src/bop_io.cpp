@@ -12,25 +12,17 @@
 #include "c3po/base/error.hpp"
 #include "c3po/geometry/rotation.hpp"
 
+#include "json_input_internal.hpp"
+
 namespace c3po {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-json ParseJson(const std::string& text, const std::string& name) {
-  try {
-    return json::parse(text);
-  } catch (const json::exception& e) {
-    throw InputError(name, std::string("not valid JSON: ") + e.what());
-  }
-}
-
+using io_detail::ParseJson;
 double Number(const json& value, const std::string& name, const std::string& field) {
-  if (!value.is_number()) throw InputError(name, field + ": expected a number");
-  const double number = value.get<double>();
-  if (!std::isfinite(number)) throw InputError(name, field + ": not a finite number");
-  return number;
+  return io_detail::FiniteNumber(value, name, field);
 }
 
 int Id(const json& value, const std::string& name, const std::string& field) {

@@ -9,25 +9,15 @@
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 
+#include "json_input_internal.hpp"
+
 namespace c3po {
 namespace {
 
 using nlohmann::json;
 
-json ParseJson(const std::string& text, const std::string& name) {
-  try {
-    return json::parse(text);
-  } catch (const json::exception& e) {
-    throw InputError(name, std::string("not valid JSON: ") + e.what());
-  }
-}
-
-double FiniteNumber(const json& value, const std::string& name, const std::string& field) {
-  if (!value.is_number()) throw InputError(name, field + ": expected a number");
-  const double number = value.get<double>();
-  if (!std::isfinite(number)) throw InputError(name, field + ": not a finite number");
-  return number;
-}
+using io_detail::ParseJson;
+using io_detail::FiniteNumber;
 
 CameraInfo CameraFromEntry(const json& entry, const std::string& name, const std::string& prefix,
                            std::optional<double> depth_scale) {
