@@ -172,7 +172,7 @@ FrameInput ResolveFrame(const FrameFlags& flags, const std::string& command) {
   if (!flags.camera_path.empty() && !flags.intrinsics.empty()) {
     throw InputError(command, "give --camera FILE or --intrinsics fx,fy,cx,cy, not both");
   }
-  if (flags.im_id && flags.camera_path.empty()) throw InputError(command, "--im-id picks an entry of --camera FILE");
+  if (flags.im_id && flags.camera_path.empty()) throw InputError("--im-id", "picks an entry of --camera FILE (a scene_camera.json); give --camera");
   if (!flags.camera_path.empty()) {
     frame.camera = ReadCameraJson(flags.camera_path, flags.depth_scale, flags.im_id);
   } else if (flags.intrinsics.empty()) {
