@@ -14,7 +14,10 @@
 #include "c3po/io/bop_dataset.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/eval/evaluation.hpp"
+#include "c3po/eval/evaluation_samples.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/io/shard.hpp"
+#include "c3po/method/image_sources.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/registry.hpp"
 #include "c3po/web/report.hpp"
@@ -47,6 +50,8 @@ struct EvalCommand {
   std::string icp_max_distance;
   double icp_trim = 0.0;
   std::string json_path;
+  std::string samples_path;   // --samples: per-sample rows for c3po merge --eval
+  std::string shard;          // --shard K/N
   std::string report_path;
   std::vector<std::string> training_logs;
   int views = 3;
@@ -230,19 +235,28 @@ int Run(const EvalCommand& cmd) {
   }
   const EvaluationOptions options = MakeOptions(cmd, object, diameter);
   if (cmd.views < 0) throw InputError("c3po eval", "--views must be >= 0");
+  const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
+  const std::string empty_part = "this part holds no clouds (choose N at most the number of " +
+                                 std::string(cmd.bop.dir.empty() ? "manifest lines)" : "images with usable instances)");
   ScratchFolder scratch;
   std::string data_dir = cmd.data_dir;
   if (!cmd.bop.dir.empty()) {
     CheckSegmentOptions(cmd.segment, "c3po eval");
     const BopInstances listed = ListBopInstances(cmd.bop.dir, cmd.bop.options);
     if (listed.instances.empty()) throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id));
+    // --shard by image, before the instances become a dataset.
+    const std::vector<BopInstance> instances = shard ? ShardBopInstances(listed.instances, *shard) : listed.instances;
+    if (instances.empty()) throw InputError("--shard " + cmd.shard, empty_part);
     data_dir = scratch.path() + "/dataset";
-    const BopDatasetSummary summary = WriteDatasetFromBop(listed.instances, object.keypoints(), cmd.segment, data_dir);
+    const BopDatasetSummary summary = WriteDatasetFromBop(instances, object.keypoints(), cmd.segment, data_dir);
     for (const std::string& reason : summary.skipped) std::cerr << "c3po eval: skipped " << reason << "\n";
     std::cerr << "c3po eval: " << summary.written << " BOP instances of obj_id " << cmd.bop.options.obj_id << " ("
               << summary.skipped.size() << " skipped)\n";
   }
-  const Dataset dataset = ReadDataset(data_dir);
+  Dataset dataset = ReadDataset(data_dir);
+  // --shard by manifest line (a BOP run was sharded above).
+  if (shard && cmd.bop.dir.empty()) dataset = ShardDataset(dataset, *shard);
+  if (shard && dataset.entries.empty()) throw InputError("--shard " + cmd.shard, empty_part);
   const std::vector<LoadedDetector> loaded = LoadDetectors(cmd, object);
   std::vector<EvaluatedDetector> detectors;
   for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});
@@ -250,9 +264,15 @@ int Run(const EvalCommand& cmd) {
   if (!cmd.report_path.empty()) logs = ReadTrainingLogs(cmd, loaded);   // fail before the long work
 
   ProgressBar progress("eval", dataset.entries.size());
-  const Evaluation evaluation =
+  Evaluation evaluation =
       Evaluate(object, dataset, detectors, options, [&](std::size_t done, std::size_t) { progress.Update(done); });
   progress.Finish();
+  // BOP input: name the BOP folder, not the temporary dataset it became.
+  if (!cmd.bop.dir.empty()) evaluation.dataset_dir = cmd.bop.dir;
+  if (!cmd.samples_path.empty()) {
+    WriteFileAtomically(cmd.samples_path, EvaluationSamplesJsonl(evaluation, shard ? cmd.shard : "1/1"));
+    std::cerr << "wrote " << cmd.samples_path << "\n";
+  }
 
   const bool json_to_stdout = cmd.json_path == "-";
   (json_to_stdout ? std::cerr : std::cout) << EvaluationTable(evaluation);
@@ -310,6 +330,9 @@ RunFunction SetupEval(CLI::App& command) {
   command.add_option("--icp-max-distance", cmd->icp_max_distance, "ICP correspondence gate (default: none)");
   command.add_option("--icp-trim", cmd->icp_trim, "ICP: fraction of the farthest pairs dropped (default 0)");
   command.add_option("--json", cmd->json_path, "Write everything as JSON to FILE (atomically); '-' = stdout (table on stderr)");
+  command.add_option("--samples", cmd->samples_path,
+                     "Write the per-sample rows as JSON lines (atomically), for c3po merge --eval of --shard parts");
+  AddShardOption(command, &cmd->shard, "clouds (by manifest line for --data, by image for --bop)");
   command.add_option("--report", cmd->report_path, "Write a self-contained HTML report");
   command.add_option("--training-log", cmd->training_logs,
                      "Training log (JSON lines) for the report; MODEL.log.jsonl next to each model is found automatically")->allow_extra_args(false);

@@ -97,9 +97,11 @@ int RunAuto(const IndicatorsCommand& cmd, ObjectModel& object) {
   options.training.noise_sigma = cmd.noise_text;
   options.degeneracy.eps_oc = Threshold(cmd.eps_oc_text, object.spec().eps_oc, object.diameter(), "--eps-oc");
   options.degeneracy.delta_nd = Threshold(cmd.delta_nd_text, object.spec().delta_nd, object.diameter(), "--delta-nd");
-  const int total = options.training.views + (options.test_views > 0 ? options.test_views : options.training.views);
-  std::fprintf(stderr, "indicators --auto: labelling %d rendered views (training seed %llu) ...\n", total,
-               static_cast<unsigned long long>(options.training.seed));
+  const int deliberate = static_cast<int>(DeliberateViews(object, options.deliberate_views).size());
+  const int total =
+      deliberate + options.training.views + (options.test_views > 0 ? options.test_views : options.training.views);
+  std::fprintf(stderr, "indicators --auto: labelling %d rendered views (%d deliberate; training seed %llu) ...\n", total,
+               deliberate, static_cast<unsigned long long>(options.training.seed));
   ProgressBar bar("views", static_cast<std::size_t>(total));
   const AutoIndicatorResult result =
       LearnIndicatorSetsFromViews(object, options, [&](std::size_t done, std::size_t) { bar.Update(done); });
@@ -121,6 +123,10 @@ int RunAuto(const IndicatorsCommand& cmd, ObjectModel& object) {
     std::printf("  set %zu: %s (accepts %d more training views)\n", k,
                 DescribeIndicatorSet(spec, result.learned.sets[k]).c_str(), result.learned.accepted_per_set[k]);
   }
+  std::printf("  deliberate views (face-on, edge-on, corner, half occluded): %zu, %s; unusable: %d\n",
+              result.deliberate_views.size(), result.deliberate_trained ? "training views" : "scored only (--no-deliberate)",
+              result.unusable_deliberate_views);
+  PrintScore("deliberate", result.deliberate_score);
   PrintScore("training", result.training_score);
   PrintScore("test    ", result.test_score);
   PrintScore(spec.indicator_sets.empty() ? "test, the object's sets (none: nd = 1 always)" : "test, the object's current sets",
@@ -180,7 +186,10 @@ RunFunction SetupIndicators(CLI::App& command) {
   command.add_option("--eps-oc", cmd->eps_oc_text, "--auto: fit threshold of the degeneracy search; default: the object's");
   command.add_flag("--auto", cmd->automatic, "Learn sets from rendered depth views (prints them; --write to save)");
   command.add_flag("--write", cmd->write, "--auto: write the learned sets and their precision/recall into the object");
-  command.add_option("--views", a.training.views, "--auto: training views (test views: as many, another seed)")->capture_default_str();
+  command.add_option("--views", a.training.views, "--auto: random training views (test views: as many, another seed)")->capture_default_str();
+  command.add_flag("!--no-deliberate", a.deliberate,
+                   "--auto: do not train on the deliberate views (face-on, edge-on, corner and half-occluded views "
+                   "from the principal axes and large planar patches; still labelled and scored)");
   command.add_option("--test-views", a.test_views, "--auto: test views (default: as many as --views)");
   command.add_option("--seed", a.training.seed, "--auto: seed of the training views")->capture_default_str();
   command.add_option("--test-seed", a.test_seed, "--auto: seed of the test views (default: seed + 1000003)");

@@ -156,7 +156,9 @@ void AddFrameOptions(CLI::App& command, FrameFlags* flags) {
   command.add_option("--mask", flags->mask_path, "Mask PNG (8/16-bit; non-zero = object, or --label-id)");
   command.add_option("--label-id", flags->label_id, "Mask is a label image: the object's pixels have this value");
   command.add_option("--camera", flags->camera_path,
-                     "Camera JSON (cam_K row-major + depth_scale; BOP camera.json or scene_camera.json entry)");
+                     "Camera JSON (cam_K row-major + depth_scale; BOP camera.json, or a scene_camera.json: "
+                     "one image, or the --im-id entry)");
+  command.add_option("--im-id", flags->im_id, "With --camera scene_camera.json: the image whose camera to use");
   command.add_option("--intrinsics", flags->intrinsics, "fx,fy,cx,cy (instead of --camera)");
   command.add_option("--depth-scale", flags->depth_scale, "Millimetres per depth unit (overrides the camera file's)");
 }
@@ -170,8 +172,9 @@ FrameInput ResolveFrame(const FrameFlags& flags, const std::string& command) {
   if (!flags.camera_path.empty() && !flags.intrinsics.empty()) {
     throw InputError(command, "give --camera FILE or --intrinsics fx,fy,cx,cy, not both");
   }
+  if (flags.im_id && flags.camera_path.empty()) throw InputError("--im-id", "picks an entry of --camera FILE (a scene_camera.json); give --camera");
   if (!flags.camera_path.empty()) {
-    frame.camera = ReadCameraJson(flags.camera_path, flags.depth_scale);
+    frame.camera = ReadCameraJson(flags.camera_path, flags.depth_scale, flags.im_id);
   } else if (flags.intrinsics.empty()) {
     throw InputError(command, "--depth needs --camera FILE or --intrinsics fx,fy,cx,cy");
   } else if (!flags.depth_scale) {

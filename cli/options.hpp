@@ -89,7 +89,7 @@ void AddSegmentOptions(CLI::App& command, SegmentOptions* options);
 // options->Check() as an InputError naming the command.
 void CheckSegmentOptions(const SegmentOptions& options, const std::string& command);
 
-// --depth, --mask, --label-id, --camera, --intrinsics, --depth-scale: one frame.
+// --depth, --mask, --label-id, --camera, --im-id, --intrinsics, --depth-scale: one frame.
 struct FrameFlags {
   std::string depth_path;
   std::string mask_path;
@@ -97,6 +97,7 @@ struct FrameFlags {
   std::string camera_path;
   std::string intrinsics;
   std::optional<double> depth_scale;
+  std::optional<int> im_id;   // --im-id: the entry of a scene_camera.json of several images
   bool given() const { return !depth_path.empty() || !mask_path.empty(); }
 };
 void AddFrameOptions(CLI::App& command, FrameFlags* flags);

@@ -11,7 +11,7 @@ shift
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${C3PO_FUZZ_BUILD:-$src/build-fuzz}
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(ply pcd xyz manifest object_json mesh poses model png bop_json rle npy)
+[ ${#targets[@]} -eq 0 ] && targets=(ply pcd xyz manifest object_json mesh poses model png bop_json rle npy eval_samples)
 
 CC=clang CXX=clang++ cmake -S "$src" -B "$build" -G Ninja -DC3PO_FUZZ=ON -DC3PO_BUILD_TESTS=OFF >/dev/null || exit 2
 cmake --build "$build" --target $(printf 'fuzz_%s ' "${targets[@]}") -j2 >/dev/null || exit 2

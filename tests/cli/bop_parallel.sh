@@ -22,6 +22,30 @@ set +e
 parallel --halt now,fail=1 "'$C3PO' certify obj5.json ${ARGS[*]} --shard {}/3 -o part{}.jsonl --bop-csv part{}.csv >/dev/null 2>&1; [ \$? -le 1 ]" ::: 1 2 3
 [ $? -eq 0 ] || fail "a GNU parallel part failed"
 set -e
+# One frame of the scene, its camera picked from the scene's scene_camera.json
+# (20 images) with --im-id: the same cloud and pose as the --bop line; without
+# --im-id, or with an id the file lacks, exit 2.
+S1="$DATA/test/000001"
+GT=$(python3 -c "import json; print([e['obj_id'] for e in json.load(open('$S1/scene_gt.json'))['2']].index(5))")
+FRAME=(--depth "$S1/depth/000002.png" --mask "$S1/mask_visib/000002_$(printf %06d "$GT").png" --camera "$S1/scene_camera.json")
+set +e
+"$C3PO" certify obj5.json --detector svd --eps-oc 3%d "${FRAME[@]}" --im-id 2 --json > frame.jsonl 2>/dev/null
+[ $? -le 1 ] || fail "certify --camera scene_camera.json --im-id 2 failed"
+"$C3PO" certify obj5.json --detector svd --eps-oc 3%d "${FRAME[@]}" --json > no_im_id.out 2> no_im_id.err
+[ $? -eq 2 ] && grep -q "scene_camera.json: a scene_camera.json of 20 images; give --im-id" no_im_id.err \
+  || fail "several cameras without --im-id: $(cat no_im_id.err)"
+"$C3PO" certify obj5.json --detector svd --eps-oc 3%d "${FRAME[@]}" --im-id 999 --json > bad_im_id.out 2> bad_im_id.err
+[ $? -eq 2 ] && grep -q "scene_camera.json: --im-id 999: no such image" bad_im_id.err || fail "absent --im-id: $(cat bad_im_id.err)"
+set -e
+python3 - "$GT" <<'PY' || fail "the --im-id frame differs from its --bop line"
+import json, sys
+gt = int(sys.argv[1])
+frame = json.loads(open('frame.jsonl').readline())
+bop = [json.loads(l) for l in open('full.jsonl')]
+line = [d for d in bop if d['scene_id'] == 1 and d['im_id'] == 2 and d['gt_id'] == gt][0]
+for key in ('points', 'pixels', 'no_depth', 'R', 't', 'certified'):
+    assert frame[key] == line[key], (key, frame[key], line[key])
+PY
 "$C3PO" merge -o merged.jsonl part1.jsonl part2.jsonl part3.jsonl
 "$C3PO" merge -o merged.csv part1.csv part2.csv part3.csv
 

@@ -23,7 +23,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       case 3: c3po::ParseTargets(text, "targets.json"); break;
       case 4: c3po::ParseModelsInfo(text, "models_info.json"); break;
-      default: c3po::ParseCameraJson(text, "camera.json"); break;
+      // The --im-id lookup too (an id derived from the selector byte).
+      default: c3po::ParseCameraJson(text, "camera.json", std::nullopt,
+                                     data[0] >= 128 ? std::optional<int>(data[0] % 8) : std::nullopt); break;
     }
   } catch (const c3po::InputError&) {
     // expected for bad input

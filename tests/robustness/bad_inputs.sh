@@ -188,6 +188,7 @@ K = [50.0, 0, 6, 0, 50.0, 5, 0, 0, 1]
 json.dump({'cam_K': K, 'depth_scale': 1.0}, open('camera.json', 'w'))
 json.dump({'depth_scale': 1.0}, open('camera_no_K.json', 'w'))
 json.dump({'cam_K': K, 'depth_scale': 0}, open('camera_scale0.json', 'w'))
+json.dump({'3': {'cam_K': K, 'depth_scale': 1.0}, '4': {'cam_K': K, 'depth_scale': 1.0}}, open('scene_camera_2.json', 'w'))
 # A BOP split: scene 000001 with image 1, instances 0 (obj 1) and 1 (obj 2).
 def scene(root, masks=(0, 1)):
     os.makedirs(root + '/depth', exist_ok=True)
@@ -214,6 +215,9 @@ check 8bit_png_as_depth "2" frame.jsonl depth_8bit.png depth_8bit.png -- "$C3PO"
 check truncated_depth_png "2" frame.jsonl depth_truncated.png depth_truncated.png -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth_truncated.png --mask mask.png --camera camera.json
 check camera_missing_cam_K "2" frame.jsonl camera_no_K.json camera_no_K.json -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --camera camera_no_K.json
 check camera_depth_scale_0 "2" frame.jsonl camera_scale0.json camera_scale0.json -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --camera camera_scale0.json
+check scene_camera_no_im_id "2" frame.jsonl scene_camera_2.json scene_camera_2.json -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --camera scene_camera_2.json
+check scene_camera_im_id_absent "2" frame.jsonl scene_camera_2.json scene_camera_2.json -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --camera scene_camera_2.json --im-id 5
+check im_id_without_camera "2" frame.jsonl im-id depth.png -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --intrinsics 50,50,6,5 --depth-scale 1 --im-id 3
 check intrinsics_depth_scale_neg "2" frame.jsonl depth-scale depth.png -- "$C3PO" certify "$CUBE" "${FRAME[@]}" --depth depth.png --mask mask.png --intrinsics 50,50,6,5 --depth-scale -1
 BOP=(--detector svd --obj-id 1 -o bop.jsonl --bop-csv bop.csv)
 check bop_non_numbered_scene "2" bop.csv split_named/extra split_named -- "$C3PO" certify "$CUBE" "${BOP[@]}" --bop split_named

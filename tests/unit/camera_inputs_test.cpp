@@ -333,6 +333,18 @@ TEST_CASE("camera JSON: cam_K, BOP camera.json, one-entry scene_camera.json, --i
   CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [-1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 1})", "c.json"); })
             .find("c.json: focal lengths must be positive") == 0);
   CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"1": {}, "2": {}})", "s.json"); }).find("s.json: a scene_camera.json of 2 images") == 0);
+  // --im-id picks one entry of a scene_camera.json of several images.
+  const std::string two = R"({"3": {"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 0.5},
+                              "4": {"cam_K": [5, 0, 6, 0, 7, 8, 0, 0, 1], "depth_scale": 0.25}})";
+  const auto four = c3po::ParseCameraJson(two, "s.json", std::nullopt, 4);
+  CHECK((four.K.fx == 5 && four.K.fy == 7 && four.K.cx == 6 && four.K.cy == 8 && four.depth_scale == 0.25));
+  const auto three = c3po::ParseCameraJson(two, "s.json", 2.0, 3);
+  CHECK((three.K.fx == 1 && three.depth_scale == 2.0));
+  CHECK(ErrorOf([&] { c3po::ParseCameraJson(two, "s.json"); }).find("s.json: a scene_camera.json of 2 images; give --im-id") == 0);
+  CHECK(ErrorOf([&] { c3po::ParseCameraJson(two, "s.json", std::nullopt, 5); }).find("s.json: --im-id 5: no such image") == 0);
+  CHECK(ErrorOf([&] { c3po::ParseCameraJson(two, "s.json", std::nullopt, -3); }).find("s.json: --im-id -3: no such image") == 0);
+  // A single camera serves every image: --im-id has nothing to pick.
+  CHECK(c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 0.1})", "c.json", std::nullopt, 9).K.fx == 1);
   CHECK(ErrorOf([] { c3po::ParseCameraJson("{", "c.json"); }).find("c.json: not valid JSON") == 0);
   CHECK(ErrorOf([] { c3po::CameraFromIntrinsics("1,2,3", 1.0); }) == "--intrinsics: expected 4 numbers fx,fy,cx,cy");
   CHECK(ErrorOf([] { c3po::CameraFromIntrinsics("1,2,3,4", 0.0); }).find("--intrinsics/--depth-scale: depth_scale must be") == 0);

@@ -271,3 +271,131 @@ TEST_CASE("LearnIndicatorSetsFromViews on the bundled mug finds the handle") {
   CHECK(evidence["precision"].get<double>() == doctest::Approx(result.test_score.precision));
   CHECK(evidence["views"].get<int>() == result.training_score.views);
 }
+
+TEST_CASE("DeliberateViews of a box: its six faces face-on, its twelve edges, eight corners, half-occluded views") {
+  const ObjectModel box = CornerBox({0.16, 0.08, 0.22});
+  const std::vector<DeliberateView> views = DeliberateViews(box, DeliberateViewOptions{});
+  const auto has = [&](ViewKind kind, const Eigen::Vector3d& direction) {
+    return std::any_of(views.begin(), views.end(), [&](const DeliberateView& v) {
+      return v.kind == kind && v.direction.dot(direction.normalized()) > std::cos(M_PI / 180.0);
+    });
+  };
+  const auto count = [&](ViewKind kind) {
+    return std::count_if(views.begin(), views.end(), [&](const DeliberateView& v) { return v.kind == kind; });
+  };
+  for (int k = 0; k < 3; ++k) {
+    for (double sign : {1.0, -1.0}) CHECK(has(ViewKind::kFaceOn, sign * Eigen::Vector3d::Unit(k)));
+  }
+  CHECK(count(ViewKind::kFaceOn) == 6);   // principal axes and face normals coincide: no duplicates
+  CHECK(count(ViewKind::kEdgeOn) == 12);
+  CHECK(has(ViewKind::kEdgeOn, {1, 1, 0}));
+  CHECK(has(ViewKind::kEdgeOn, {0, -1, 1}));
+  CHECK(count(ViewKind::kCorner) == 8);
+  CHECK(has(ViewKind::kCorner, {1, -1, 1}));   // the principal frame of a box is its own (signs aside)
+  CHECK(count(ViewKind::kPartial) == 2 * (6 + 8));
+  for (const DeliberateView& v : views) CHECK(v.direction.norm() == doctest::Approx(1.0));
+
+  // A half-occluded view keeps one side of the image: about half of the
+  // 2 x 2000 points drawn (deliberate views are dense), all on that side.
+  ViewSamplingOptions sampling;
+  sampling.points = 800;
+  DepthRenderer renderer(sampling.camera);
+  const auto partial = std::find_if(views.begin(), views.end(), [](const DeliberateView& v) {
+    return v.kind == ViewKind::kPartial && v.cut_axis == 1;
+  });
+  REQUIRE(partial != views.end());
+  const RenderedView cut = RenderDeliberateView(box, sampling, 0.0, *partial, 3, &renderer);
+  CHECK(cut.cloud.cols() > 1500);
+  CHECK(cut.cloud.cols() < 2500);
+  CHECK(cut.cloud.row(1).minCoeff() >= 0.0);
+  // Rendered at the truth: every point lies on the posed box.
+  CHECK(box.DistancesToPosedModel(cut.cloud, cut.camera_from_model).maxCoeff() < box.spec().eps_oc);
+  DeliberateView face = views.front();
+  const RenderedView a = RenderDeliberateView(box, sampling, 0.001, face, 0, &renderer);
+  const RenderedView b = RenderDeliberateView(box, sampling, 0.001, face, 0, &renderer);
+  CHECK(a.cloud.isApprox(b.cloud, 0.0));   // deterministic
+}
+
+TEST_CASE("DeliberateViews finds the normals of large planar patches off the principal axes") {
+  // A box rotated off the model axes: its six faces are the large planar
+  // patches, with outward normals ±R e_k (exact); the principal axes are the
+  // same directions, so without the de-duplication each is listed twice.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  ObjectSpec spec;
+  spec.name = "tilted";
+  spec.keypoints = Eigen::Matrix3Xd::Zero(3, 1);
+  spec.eps_oc = 0.008;
+  spec.delta_nd = 0.008;
+  Mesh mesh = test::BoxMesh({0, 0, 0}, {0.3, 0.2, 0.1});
+  mesh.vertices = R * mesh.vertices;
+  ObjectModelOptions options;
+  options.sample_size = 4000;
+  const ObjectModel tilted(spec, mesh, options);
+  DeliberateViewOptions only_patches;
+  only_patches.partial = false;
+  only_patches.min_separation_deg = 0.0;   // keep the duplicates: axes and patches both listed
+  const std::vector<DeliberateView> views = DeliberateViews(tilted, only_patches);
+  int face_on = 0;
+  for (const DeliberateView& v : views) face_on += v.kind == ViewKind::kFaceOn;
+  CHECK(face_on == 12);   // 6 principal directions + 6 patch normals
+  for (int k = 0; k < 3; ++k) {
+    for (double sign : {1.0, -1.0}) {
+      const Eigen::Vector3d normal = sign * R.col(k);
+      int matches = 0;
+      for (const DeliberateView& v : views) matches += v.kind == ViewKind::kFaceOn && v.direction.dot(normal) > 0.9999;
+      CHECK(matches == 2);   // once as a principal axis, once as an outward patch normal
+    }
+  }
+}
+
+TEST_CASE("indicators --auto with deliberate views: independent face-on box views are never accepted") {
+  const ObjectModel box = CornerBox({0.16, 0.08, 0.22});
+  AutoIndicatorOptions options;
+  options.training.views = 12;   // few random views: the deliberate ones carry the degenerate cases
+  options.training.points = 400;
+  options.test_views = 12;
+  const AutoIndicatorResult result = LearnIndicatorSetsFromViews(box, options);
+  CHECK(result.deliberate_trained);
+  CHECK(result.training_views.size() == 12);
+  CHECK(result.deliberate_labels.size() == result.deliberate_views.size());
+  // Face-on views of the two smaller faces are degenerate (a wrong pose lays
+  // them inside a larger face) and are among the deliberate views.
+  int face_on_degenerate = 0;
+  for (std::size_t i = 0; i < result.deliberate_views.size(); ++i) {
+    face_on_degenerate += result.deliberate_views[i].kind == ViewKind::kFaceOn && result.deliberate_labels[i].degenerate;
+  }
+  CHECK(face_on_degenerate >= 4);
+  CHECK(result.deliberate_score.false_accepts == 0);
+  REQUIRE_FALSE(result.learned.accept_all);
+  // Independent face-on views (another seed, distance, roll, noise and 3000
+  // points): no learned set is all seen, so nd = 0 and such a view is never
+  // certified, for every face.
+  const DegeneracyOptions thresholds = Thresholds(box);
+  ViewSamplingOptions other;
+  other.seed = 77;
+  other.points = 3000;
+  other.distance_min = other.distance_max = 0.7;
+  DepthRenderer renderer(other.camera);
+  for (int k = 0; k < 3; ++k) {
+    for (double sign : {1.0, -1.0}) {
+      DeliberateView face;
+      face.direction = sign * Eigen::Vector3d::Unit(k);
+      const RenderedView view = RenderDeliberateView(box, other, 0.0005, face, 2 * k + (sign > 0), &renderer);
+      const PointSet posed_keypoints = view.camera_from_model * box.keypoints();
+      std::uint64_t seen = 0;
+      for (int i = 0; i < box.num_keypoints(); ++i) {
+        if ((view.cloud.colwise() - posed_keypoints.col(i)).colwise().norm().minCoeff() < thresholds.delta_nd) {
+          seen |= std::uint64_t{1} << i;
+        }
+      }
+      for (const IndicatorSet& set : result.learned.sets) {
+        bool all = true;
+        for (int i : set) all = all && ((seen >> i) & 1);
+        CHECK_MESSAGE(!all, "face-on view along axis " << k << " sign " << sign << " accepted by a set; seen " << seen);
+      }
+    }
+  }
+  const auto evidence = nlohmann::json::parse(result.EvidenceJson());
+  CHECK(evidence["deliberate_views"]["face-on"]["views"].get<int>() == 6);
+  CHECK(evidence["deliberate_false_accepts"].get<int>() == 0);
+}

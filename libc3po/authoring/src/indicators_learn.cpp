@@ -207,6 +207,18 @@ std::string AutoIndicatorResult::EvidenceJson() const {
   doc["accept_all"] = learned.accept_all;
   doc["previous_sets_precision"] = current_test_score.precision;
   doc["previous_sets_recall"] = current_test_score.recall;
+  // The deliberate views (face-on, edge-on, corner, partial) and how the sets treat them.
+  nlohmann::json kinds = nlohmann::json::object();
+  for (std::size_t i = 0; i < deliberate_views.size() && i < deliberate_labels.size(); ++i) {
+    auto& k = kinds[ToString(deliberate_views[i].kind)];
+    if (k.is_null()) k = {{"views", 0}, {"degenerate", 0}};
+    k["views"] = k["views"].get<int>() + 1;
+    k["degenerate"] = k["degenerate"].get<int>() + (deliberate_labels[i].usable && deliberate_labels[i].degenerate);
+  }
+  doc["deliberate_trained"] = deliberate_trained;
+  doc["deliberate_views"] = kinds;
+  doc["deliberate_false_accepts"] = deliberate_score.false_accepts;
+  doc["deliberate_degenerate"] = deliberate_score.degenerate;
   return doc.dump();
 }
 
@@ -230,33 +242,55 @@ AutoIndicatorResult LearnIndicatorSetsFromViews(const ObjectModel& object,
   result.test_seed = test.seed;
 
   const std::vector<Pose> motions = DegeneracySearchMotions(object);
-  const int total = training.views + test.views;
+  // The deliberate (face-on, edge-on, corner, partial) views are always
+  // labelled and scored; with options.deliberate they are training views too.
+  // Test views are random only.
+  result.deliberate_views = DeliberateViews(object, options.deliberate_views);
+  const int deliberate = static_cast<int>(result.deliberate_views.size());
+  const int random_start = deliberate;
+  const int test_start = random_start + training.views;
+  const int total = test_start + test.views;
+  result.deliberate_labels.resize(deliberate);
   result.training_views.resize(training.views);
   result.test_views.resize(test.views);
   RendererPool pool(training.camera);
   std::atomic<std::size_t> done{0};
   ParallelFor(0, total, [&](int item) {
     ThrowIfInterrupted();
-    const bool is_training = item < training.views;
-    const ViewSamplingOptions& sampling = is_training ? training : test;
-    const int index = is_training ? item : item - training.views;
     auto renderer = pool.Take();
-    const RenderedView view = RenderView(object, sampling, result.noise_sigma, index, renderer.get());
+    RenderedView view;
+    ViewDegeneracy* label = nullptr;
+    if (item < random_start) {
+      view = RenderDeliberateView(object, training, result.noise_sigma, result.deliberate_views[item], item,
+                                  renderer.get());
+      label = &result.deliberate_labels[item];
+    } else if (item < test_start) {
+      view = RenderView(object, training, result.noise_sigma, item - random_start, renderer.get());
+      label = &result.training_views[item - random_start];
+    } else {
+      view = RenderView(object, test, result.noise_sigma, item - test_start, renderer.get());
+      label = &result.test_views[item - test_start];
+    }
     pool.Give(std::move(renderer));
-    (is_training ? result.training_views : result.test_views)[index] =
-        AnalyzeViewDegeneracy(object, view.cloud, view.camera_from_model, motions, degeneracy);
+    *label = AnalyzeViewDegeneracy(object, view.cloud, view.camera_from_model, motions, degeneracy);
     const std::size_t finished = ++done;
     if (progress) progress(finished, static_cast<std::size_t>(total));
   });
 
   const double borderline = options.learning.borderline_factor * degeneracy.tolerance_factor * degeneracy.eps_oc;
-  const std::vector<LabelledView> training_labels =
+  std::vector<LabelledView> training_labels =
       UsableLabels(result.training_views, borderline, &result.unusable_training_views);
   const std::vector<LabelledView> test_labels = UsableLabels(result.test_views, borderline, &result.unusable_test_views);
+  const std::vector<LabelledView> deliberate_labels =
+      UsableLabels(result.deliberate_labels, borderline, &result.unusable_deliberate_views);
+  if (options.deliberate) training_labels.insert(training_labels.begin(), deliberate_labels.begin(), deliberate_labels.end());
   result.learned = LearnIndicatorSets(training_labels, object.num_keypoints(), options.learning);
   result.training_score = ScoreIndicatorSets(result.learned.sets, training_labels);
   result.test_score = ScoreIndicatorSets(result.learned.sets, test_labels);
   result.current_test_score = ScoreIndicatorSets(object.spec().indicator_sets, test_labels);
+  result.deliberate_score = ScoreIndicatorSets(result.learned.sets, deliberate_labels);
+  result.current_deliberate_score = ScoreIndicatorSets(object.spec().indicator_sets, deliberate_labels);
+  result.deliberate_trained = options.deliberate;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;
 }

@@ -4,6 +4,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <tuple>
 
 #include "c3po/authoring/indicators.hpp"
 #include "c3po/base/error.hpp"
@@ -60,7 +62,186 @@ std::vector<Eigen::Matrix3d> CubeGroup() {
   return group;
 }
 
+// Centroid and principal axes (columns, right-handed) of the object's surface sample.
+std::pair<Eigen::Vector3d, Eigen::Matrix3d> PrincipalFrame(const ObjectModel& object) {
+  const PointSet& sample = object.sample();
+  const Eigen::Vector3d centroid = sample.rowwise().mean();
+  const PointSet centred = sample.colwise() - centroid;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(centred * centred.transpose());
+  Eigen::Matrix3d axes = pca.eigenvectors();
+  if (axes.determinant() < 0) axes.col(0) = -axes.col(0);
+  return {centroid, axes};
+}
+
+constexpr std::uint64_t kDeliberateSeedSalt = 0x9e3779b97f4a7c15ULL;
+constexpr int kDeliberatePoints = 2000;
+
+// Outward normals of the large planar patches of the mesh: triangles binned
+// by quantised normal (cells of about `angle` radians on a latitude/longitude
+// grid) and plane offset (cells of 2 % of d); bins holding at least
+// `min_fraction` of the area, largest first.
+std::vector<Eigen::Vector3d> PlanarPatchNormals(const ObjectModel& object, double angle, double min_fraction,
+                                                int max_patches) {
+  const Mesh& mesh = object.mesh();
+  const Eigen::Vector3d centre = object.sample().rowwise().mean();
+  const double offset_cell = 0.02 * object.diameter();
+  struct Bin {
+    Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();   // area-weighted
+    Eigen::Vector3d centroid_sum = Eigen::Vector3d::Zero();
+    double area = 0.0;
+  };
+  std::map<std::tuple<long, long, long>, Bin> bins;
+  double total = 0.0;
+  for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
+    const Eigen::Vector3d a = mesh.vertices.col(mesh.triangles(0, t));
+    const Eigen::Vector3d b = mesh.vertices.col(mesh.triangles(1, t));
+    const Eigen::Vector3d c = mesh.vertices.col(mesh.triangles(2, t));
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    const double area = 0.5 * cross.norm();
+    if (!(area > 0) || !std::isfinite(area)) continue;
+    total += area;
+    const Eigen::Vector3d n = cross.normalized();
+    const Eigen::Vector3d mid = (a + b + c) / 3.0;
+    const double polar = std::acos(std::clamp(n.z(), -1.0, 1.0));
+    const long polar_bin = std::lround(polar / angle);
+    // Longitude cells shrink towards the poles: as many as fit at this latitude.
+    const long ring = std::max(1L, std::lround(2.0 * kPi * std::sin(polar_bin * angle) / angle));
+    const long azimuth_bin =
+        (polar_bin == 0 || polar_bin * angle >= kPi - 1e-9) ? 0 : std::lround((std::atan2(n.y(), n.x()) + kPi) / (2 * kPi) * ring) % ring;
+    const long offset_bin = std::lround(n.dot(mid) / offset_cell);
+    Bin& bin = bins[{polar_bin, azimuth_bin, offset_bin}];
+    bin.normal_sum += area * n;
+    bin.centroid_sum += area * mid;
+    bin.area += area;
+  }
+  std::vector<std::pair<double, Eigen::Vector3d>> patches;
+  for (const auto& [key, bin] : bins) {
+    if (bin.area < min_fraction * total || bin.normal_sum.norm() < 1e-12) continue;
+    Eigen::Vector3d n = bin.normal_sum.normalized();
+    // Outward: the patch lies on the normal's side of the object's centre
+    // (meshes are not always wound consistently).
+    if (n.dot(bin.centroid_sum / bin.area - centre) < 0) n = -n;
+    patches.emplace_back(bin.area, n);
+  }
+  std::stable_sort(patches.begin(), patches.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+  std::vector<Eigen::Vector3d> normals;
+  for (const auto& patch : patches) {
+    if (static_cast<int>(normals.size()) >= max_patches) break;
+    normals.push_back(patch.second);
+  }
+  return normals;
+}
+
 }  // namespace
+
+const char* ToString(ViewKind kind) {
+  switch (kind) {
+    case ViewKind::kRandom: return "random";
+    case ViewKind::kFaceOn: return "face-on";
+    case ViewKind::kEdgeOn: return "edge-on";
+    case ViewKind::kCorner: return "corner";
+    case ViewKind::kPartial: return "partial";
+  }
+  return "?";
+}
+
+void DeliberateViewOptions::Check() const {
+  if (!(min_patch_fraction > 0 && min_patch_fraction < 1)) throw InputError("min_patch_fraction", "must be in (0, 1)");
+  if (!(patch_angle_deg > 0 && patch_angle_deg <= 45)) throw InputError("patch_angle_deg", "must be in (0, 45]");
+  if (!(min_separation_deg >= 0 && min_separation_deg < 60)) throw InputError("min_separation_deg", "must be in [0, 60)");
+  if (max_patches < 0) throw InputError("max_patches", "must be >= 0");
+}
+
+std::vector<DeliberateView> DeliberateViews(const ObjectModel& object, const DeliberateViewOptions& options) {
+  options.Check();
+  const double separation = std::cos(options.min_separation_deg * kPi / 180.0);
+  std::vector<DeliberateView> views;
+  // Adds a view unless one of the same kind looks (almost) the same way.
+  const auto add = [&](ViewKind kind, const Eigen::Vector3d& direction, std::vector<Eigen::Vector3d>* kept) {
+    if (!(direction.norm() > 1e-9)) return;
+    const Eigen::Vector3d d = direction.normalized();
+    for (const Eigen::Vector3d& other : *kept) {
+      if (other.dot(d) > separation) return;
+    }
+    kept->push_back(d);
+    views.push_back({kind, d, -1});
+  };
+  const Eigen::Matrix3d axes = PrincipalFrame(object).second;
+  std::vector<Eigen::Vector3d> faces;
+  for (int k = 0; k < 3; ++k) {
+    for (double sign : {1.0, -1.0}) add(ViewKind::kFaceOn, sign * axes.col(k), &faces);
+  }
+  for (const Eigen::Vector3d& n : PlanarPatchNormals(object, options.patch_angle_deg * kPi / 180.0,
+                                                     options.min_patch_fraction, options.max_patches)) {
+    add(ViewKind::kFaceOn, n, &faces);
+  }
+  std::vector<Eigen::Vector3d> edges;
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    for (std::size_t j = i + 1; j < faces.size(); ++j) {
+      const double cosine = faces[i].dot(faces[j]);
+      if (cosine > -0.5 && cosine < 0.5) add(ViewKind::kEdgeOn, faces[i] + faces[j], &edges);
+    }
+  }
+  std::vector<Eigen::Vector3d> corners;
+  for (int signs = 0; signs < 8; ++signs) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) d += ((signs >> k) & 1 ? -1.0 : 1.0) * axes.col(k);
+    add(ViewKind::kCorner, d, &corners);
+  }
+  if (options.partial) {
+    std::vector<Eigen::Vector3d> occluded = faces;
+    occluded.insert(occluded.end(), corners.begin(), corners.end());
+    for (const Eigen::Vector3d& d : occluded) {
+      for (int axis : {0, 1}) views.push_back({ViewKind::kPartial, d, axis});
+    }
+  }
+  return views;
+}
+
+RenderedView RenderDeliberateView(const ObjectModel& object, const ViewSamplingOptions& options,
+                                  double noise_sigma, const DeliberateView& deliberate, int index,
+                                  DepthRenderer* renderer) {
+  const Eigen::Vector3d centre = object.mesh().BoundingBox().center();
+  double distance = 0.5 * (options.distance_min + options.distance_max);
+  if (options.distance_min <= 0 && options.distance_max <= 0) {
+    distance = options.camera.fy * object.diameter() / (0.4 * options.camera.height);   // as RenderView's D0
+  }
+  Rng rng = Rng::ForItem(options.seed ^ kDeliberateSeedSalt, static_cast<std::uint64_t>(index));
+  RenderedView view;
+  view.direction = deliberate.direction.normalized();
+  DepthSampleOptions sampling;
+  // Densely sampled (at least kDeliberatePoints): a degenerate view blocks
+  // exactly the indicator sets it sees, so a keypoint that a sparse sample
+  // happens to miss (a face's corner) would leave its sets unblocked while a
+  // dense real cloud of the same view sees it. A partial view keeps about
+  // half of the points: twice as many are drawn.
+  sampling.points = std::max(options.points, kDeliberatePoints) * (deliberate.kind == ViewKind::kPartial ? 2 : 1);
+  sampling.noise_sigma = std::max(0.0, noise_sigma);
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    const double roll = rng.Uniform(0.0, 2.0 * kPi);
+    Pose camera_from_model;
+    camera_from_model.R = LookAtRotation(view.direction, roll);
+    camera_from_model.t = -(camera_from_model.R * (centre + distance * view.direction));
+    renderer->Render(object.mesh(), camera_from_model);
+    view.camera_from_model = camera_from_model;
+    PointSet cloud = renderer->SampleCloud(sampling, rng);
+    if (deliberate.kind == ViewKind::kPartial) {
+      // The occluder: a plane through the centre (on the optical axis) and the
+      // axis; the points on its negative side are hidden.
+      const int axis = deliberate.cut_axis == 1 ? 1 : 0;
+      std::vector<Eigen::Index> kept;
+      for (Eigen::Index i = 0; i < cloud.cols(); ++i) {
+        if (cloud(axis, i) >= 0.0) kept.push_back(i);
+      }
+      PointSet cut(3, static_cast<Eigen::Index>(kept.size()));
+      for (std::size_t i = 0; i < kept.size(); ++i) cut.col(static_cast<Eigen::Index>(i)) = cloud.col(kept[i]);
+      cloud = std::move(cut);
+    }
+    view.cloud = std::move(cloud);
+    if (view.cloud.cols() >= options.min_points) break;
+  }
+  return view;
+}
 
 void ViewSamplingOptions::Check() const {
   if (views < 1 || views > 1000000) throw InputError("--views", "must be in [1, 1000000]");
@@ -119,12 +300,7 @@ void DegeneracyOptions::Check() const {
 }
 
 std::vector<Pose> DegeneracySearchMotions(const ObjectModel& object) {
-  const PointSet& sample = object.sample();
-  const Eigen::Vector3d centroid = sample.rowwise().mean();
-  const PointSet centred = sample.colwise() - centroid;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(centred * centred.transpose());
-  Eigen::Matrix3d axes = pca.eigenvectors();   // principal frame, columns
-  if (axes.determinant() < 0) axes.col(0) = -axes.col(0);
+  const auto [centroid, axes] = PrincipalFrame(object);   // principal frame, columns
 
   std::vector<Pose> motions;
   for (const Eigen::Matrix3d& m : CubeGroup()) {   // the identity comes first

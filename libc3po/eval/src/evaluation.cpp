@@ -170,50 +170,26 @@ void CheckDataset(const Dataset& dataset, const std::vector<EvaluatedDetector>& 
   }
 }
 
-EvaluationRow MakeRow(EvalMethod method, EvalSubset subset, const std::string& detector,
-                      std::vector<SampleResult> samples, const EvaluationOptions& options, double diameter) {
-  EvaluationRow row;
-  row.label = RowLabel(method, subset, detector);
-  row.detector = detector;
-  row.method = method;
-  row.subset = subset;
-  row.samples = std::move(samples);
-  row.summary = Summarize(row.samples, options, diameter);
-  return row;
-}
-
-std::vector<SampleResult> Filter(const std::vector<SampleResult>& samples, EvalSubset subset) {
-  std::vector<SampleResult> kept;
-  for (const auto& s : samples) {
-    if (subset == EvalSubset::kAll || (subset == EvalSubset::kObservablyCorrect && s.oc) ||
-        (subset == EvalSubset::kCertified && s.certified())) {
-      kept.push_back(s);
-    }
-  }
-  return kept;
-}
-
 void AppendRows(const EvaluatedDetector& detector, DetectorResults results,
                 const EvaluationOptions& options, double diameter, std::vector<EvaluationRow>* rows) {
   const std::string& label = detector.label;
   if (detector.self_trained) {
     for (EvalSubset subset : {EvalSubset::kAll, EvalSubset::kObservablyCorrect, EvalSubset::kCertified}) {
-      rows->push_back(MakeRow(EvalMethod::kC3po, subset, label, Filter(results[kCorrected], subset),
-                              options, diameter));
+      rows->push_back(MakeEvaluationRow(EvalMethod::kC3po, subset, label, results[kCorrected], options, diameter));
     }
     return;
   }
-  rows->push_back(MakeRow(EvalMethod::kKeyPo, EvalSubset::kAll, label, std::move(results[kRegistration]),
+  rows->push_back(MakeEvaluationRow(EvalMethod::kKeyPo, EvalSubset::kAll, label, std::move(results[kRegistration]),
                           options, diameter));
   if (options.run_icp) {
-    rows->push_back(MakeRow(EvalMethod::kKeyPoIcp, EvalSubset::kAll, label, std::move(results[kIcp]),
+    rows->push_back(MakeEvaluationRow(EvalMethod::kKeyPoIcp, EvalSubset::kAll, label, std::move(results[kIcp]),
                             options, diameter));
     if (options.run_ransac) {
-      rows->push_back(MakeRow(EvalMethod::kKeyPoRansacIcp, EvalSubset::kAll, label,
+      rows->push_back(MakeEvaluationRow(EvalMethod::kKeyPoRansacIcp, EvalSubset::kAll, label,
                               std::move(results[kRansacIcp]), options, diameter));
     }
   }
-  rows->push_back(MakeRow(EvalMethod::kKeyPoCorrector, EvalSubset::kAll, label,
+  rows->push_back(MakeEvaluationRow(EvalMethod::kKeyPoCorrector, EvalSubset::kAll, label,
                           std::move(results[kCorrected]), options, diameter));
 }
 
@@ -293,6 +269,24 @@ const EvaluationRow* Evaluation::MainRow() const {
     if (row.method == EvalMethod::kKeyPoCorrector) return &row;
   }
   return rows.empty() ? nullptr : &rows.front();
+}
+
+EvaluationRow MakeEvaluationRow(EvalMethod method, EvalSubset subset, const std::string& detector,
+                                const std::vector<SampleResult>& all_samples, const EvaluationOptions& options,
+                                double diameter) {
+  EvaluationRow row;
+  row.label = RowLabel(method, subset, detector);
+  row.detector = detector;
+  row.method = method;
+  row.subset = subset;
+  for (const auto& s : all_samples) {
+    if (subset == EvalSubset::kAll || (subset == EvalSubset::kObservablyCorrect && s.oc) ||
+        (subset == EvalSubset::kCertified && s.certified())) {
+      row.samples.push_back(s);
+    }
+  }
+  row.summary = Summarize(row.samples, options, diameter);
+  return row;
 }
 
 RowSummary Summarize(const std::vector<SampleResult>& samples, const EvaluationOptions& options,

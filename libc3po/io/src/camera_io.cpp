@@ -70,21 +70,33 @@ void CheckCamera(const CameraInfo& camera, const std::string& where) {
   camera.K.Check(where);
 }
 
-CameraInfo ParseCameraJson(const std::string& text, const std::string& name, std::optional<double> depth_scale) {
+CameraInfo ParseCameraJson(const std::string& text, const std::string& name, std::optional<double> depth_scale,
+                           std::optional<int> im_id) {
   const json doc = ParseJson(text, name);
   if (AllKeysNumbered(doc)) {
+    if (im_id) {
+      const std::string key = std::to_string(*im_id);
+      // BOP writes keys without leading zeros; accept "000007" as well.
+      for (const auto& item : doc.items()) {
+        if (std::stol(item.key()) == *im_id) return CameraFromEntry(item.value(), name, item.key() + ": ", depth_scale);
+      }
+      throw InputError(name, "--im-id " + key + ": no such image among its " + std::to_string(doc.size()) +
+                                 " entries (first id " + doc.items().begin().key() + ")");
+    }
     if (doc.size() != 1) {
       throw InputError(name, "a scene_camera.json of " + std::to_string(doc.size()) +
-                                 " images; give one camera (a single entry, or use --bop)");
+                                 " images; give --im-id ID (or a single entry, or use --bop)");
     }
     const auto item = doc.items().begin();
     return CameraFromEntry(item.value(), name, item.key() + ": ", depth_scale);
   }
+  // One camera (a scene_camera.json entry or BOP camera.json): it serves every
+  // image, so --im-id has nothing to pick.
   return CameraFromEntry(doc, name, "", depth_scale);
 }
 
-CameraInfo ReadCameraJson(const std::string& path, std::optional<double> depth_scale) {
-  return ParseCameraJson(ReadFileToString(path), path, depth_scale);
+CameraInfo ReadCameraJson(const std::string& path, std::optional<double> depth_scale, std::optional<int> im_id) {
+  return ParseCameraJson(ReadFileToString(path), path, depth_scale, im_id);
 }
 
 std::map<int, CameraInfo> ParseSceneCamera(const std::string& text, const std::string& name) {

@@ -40,6 +40,19 @@ std::vector<std::size_t> ShardJobs(const std::vector<std::int64_t>& group_keys, 
   return jobs;
 }
 
+std::int64_t ImageGroupKey(int scene_id, int im_id) {
+  return static_cast<std::int64_t>(scene_id) * 1000000000LL + im_id;
+}
+
+Dataset ShardDataset(const Dataset& dataset, const Shard& shard) {
+  std::vector<std::int64_t> keys(dataset.entries.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) keys[i] = static_cast<std::int64_t>(i);
+  Dataset part;
+  part.dir = dataset.dir;
+  for (std::size_t i : ShardJobs(keys, shard)) part.entries.push_back(dataset.entries[i]);
+  return part;
+}
+
 std::string MergeShardOutputs(const std::vector<std::pair<std::string, std::string>>& parts, bool csv) {
   std::string merged, header;
   for (const auto& [name, text] : parts) {

@@ -51,14 +51,22 @@ std::vector<CloudSource> ShardSources(const std::vector<CloudSource>& sources, c
   std::int64_t next_single = -1;   // negative keys: sources that are groups of their own
   for (const CloudSource& source : sources) {
     if (source.provenance) {
-      keys.push_back(static_cast<std::int64_t>(source.provenance->scene_id) * 1000000000LL +
-                     source.provenance->im_id);
+      keys.push_back(ImageGroupKey(source.provenance->scene_id, source.provenance->im_id));
     } else {
       keys.push_back(next_single--);
     }
   }
   std::vector<CloudSource> part;
   for (std::size_t i : ShardJobs(keys, shard)) part.push_back(sources[i]);
+  return part;
+}
+
+std::vector<BopInstance> ShardBopInstances(const std::vector<BopInstance>& instances, const Shard& shard) {
+  std::vector<std::int64_t> keys;
+  keys.reserve(instances.size());
+  for (const BopInstance& instance : instances) keys.push_back(ImageGroupKey(instance.scene_id, instance.im_id));
+  std::vector<BopInstance> part;
+  for (std::size_t i : ShardJobs(keys, shard)) part.push_back(instances[i]);
   return part;
 }
 

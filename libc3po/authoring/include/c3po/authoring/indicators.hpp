@@ -108,6 +108,50 @@ struct RenderedView {
 RenderedView RenderView(const ObjectModel& object, const ViewSamplingOptions& options,
                         double noise_sigma, int index, DepthRenderer* renderer);
 
+// Views chosen to be degenerate on purpose (issue 16): random directions
+// rarely look exactly face-on or edge-on (about 1 % of them), yet those are
+// the views a wrong pose can explain. From the model alone:
+//  - face-on: along ± each principal axis and along the outward normal of
+//    every large planar patch (mesh triangles grouped by normal within
+//    patch_angle_deg and by plane offset within 2 % of d; a patch counts when
+//    its area is at least min_patch_fraction of the surface);
+//  - edge-on: the bisector of every two face-on directions 60-120 degrees
+//    apart (two faces seen, meeting at their common edge);
+//  - corner: the sum of three mutually perpendicular principal directions
+//    (the informative three-face view), used for the partial views;
+//  - partial: a face-on or corner view with half the image occluded by a
+//    plane through the object's centre containing the optical axis (the
+//    points on one side dropped), once along the image's x and once along y.
+// Directions closer than min_separation_deg to an earlier one are dropped.
+enum class ViewKind { kRandom, kFaceOn, kEdgeOn, kCorner, kPartial };
+const char* ToString(ViewKind kind);   // "random", "face-on", "edge-on", "corner", "partial"
+
+struct DeliberateView {
+  ViewKind kind = ViewKind::kFaceOn;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();   // model frame, object -> camera
+  int cut_axis = -1;   // kPartial: 0 = keep image x >= centre's, 1 = keep image y >= centre's
+};
+
+struct DeliberateViewOptions {
+  double min_patch_fraction = 0.03;   // planar patch area / surface area
+  double patch_angle_deg = 10.0;
+  double min_separation_deg = 8.0;
+  int max_patches = 24;
+  bool partial = true;
+  void Check() const;                 // throws InputError
+};
+
+std::vector<DeliberateView> DeliberateViews(const ObjectModel& object, const DeliberateViewOptions& options);
+
+// Renders one deliberate view (distance at the middle of the range, roll and
+// noise drawn from Rng::ForItem(options.seed ^ salt, index)), with at least
+// 2000 points (twice that before a partial view's cut): dense enough that the
+// keypoints it sees are not missed by sampling (a degenerate view blocks
+// exactly the sets it sees).
+RenderedView RenderDeliberateView(const ObjectModel& object, const ViewSamplingOptions& options,
+                                  double noise_sigma, const DeliberateView& view, int index,
+                                  DepthRenderer* renderer);
+
 struct DegeneracyOptions {
   double eps_oc = 0.0;          // fit threshold (absolute); <= 0: the object's
   double delta_nd = 0.0;        // "seen" threshold (absolute); <= 0: the object's
@@ -190,6 +234,8 @@ SetScore ScoreIndicatorSets(const std::vector<IndicatorSet>& sets,
 
 struct AutoIndicatorOptions {
   ViewSamplingOptions training;     // the views the sets are learned from
+  bool deliberate = true;           // train on the DeliberateViews too (they are always labelled and scored)
+  DeliberateViewOptions deliberate_views;
   std::uint64_t test_seed = 0;      // seed of the separate test views; 0 = training seed + 1000003
   int test_views = -1;              // -1: as many as the training views
   DegeneracyOptions degeneracy;
@@ -202,6 +248,10 @@ struct AutoIndicatorResult {
   SetScore training_score;
   SetScore test_score;
   SetScore current_test_score;      // the object's own sets on the same test views
+  SetScore deliberate_score;        // the learned sets on the deliberate views
+  SetScore current_deliberate_score;   // the object's own sets on them
+  bool deliberate_trained = false;  // the deliberate views were training views
+  int unusable_deliberate_views = 0;
   double eps_oc = 0.0;              // the resolved thresholds
   double delta_nd = 0.0;
   double noise_sigma = 0.0;
@@ -209,7 +259,9 @@ struct AutoIndicatorResult {
   std::uint64_t test_seed = 0;
   int unusable_training_views = 0;  // the true pose did not fit within eps_oc
   int unusable_test_views = 0;
-  std::vector<ViewDegeneracy> training_views;
+  std::vector<DeliberateView> deliberate_views;
+  std::vector<ViewDegeneracy> deliberate_labels;  // per deliberate view
+  std::vector<ViewDegeneracy> training_views;     // the random training views
   std::vector<ViewDegeneracy> test_views;
   double seconds = 0.0;
   // {"precision", "recall", "views", "test_views", "seed", "test_seed", ...}

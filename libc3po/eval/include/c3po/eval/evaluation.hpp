@@ -137,6 +137,12 @@ struct Evaluation {
 RowSummary Summarize(const std::vector<SampleResult>& samples, const EvaluationOptions& options,
                      double diameter);
 
+// The row of `method` on `subset` of one detector's samples on all clouds
+// (dataset order): the samples of the subset, labelled and summarized.
+EvaluationRow MakeEvaluationRow(EvalMethod method, EvalSubset subset, const std::string& detector,
+                                const std::vector<SampleResult>& all_samples, const EvaluationOptions& options,
+                                double diameter);
+
 // Runs every detector on every cloud of the dataset (in parallel over clouds)
 // and returns the rows in the order: for each detector, its KeyPo, + ICP,
 // + RANSAC + ICP, + corrector rows (or its three C-3PO rows when self-trained). Throws

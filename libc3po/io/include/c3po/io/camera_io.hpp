@@ -2,7 +2,8 @@
 // Camera intrinsics and depth images from files (issue 15; docs/camera_inputs.md).
 //  - Camera JSON: {"cam_K": [9 numbers, row-major], "depth_scale": s} (a BOP
 //    scene_camera.json entry), {"fx", "fy", "cx", "cy", "depth_scale", ...}
-//    (a BOP camera.json), or a scene_camera.json holding exactly one image.
+//    (a BOP camera.json), or a scene_camera.json: its entry `im_id` when
+//    given, else it must hold exactly one image.
 //  - Depth: a 16-bit PNG (value x depth_scale = millimetres, 0 = none) or a
 //    .npy array of float32/float64 depths in metres (shape (H, W), 0 or NaN =
 //    none).
@@ -21,12 +22,16 @@ struct CameraInfo {
 };
 
 // One camera from JSON text (forms above). `depth_scale` overrides the file's
-// (and is required when the file has none). Throws InputError("name: ...")
-// for missing cam_K, a cam_K that is not [fx 0 cx; 0 fy cy; 0 0 1],
+// (and is required when the file has none). `im_id` picks the entry of a
+// scene_camera.json (ignored for a single camera). Throws InputError("name: ...")
+// for a scene_camera.json of several images without `im_id`, an `im_id` it
+// does not hold, missing cam_K, a cam_K that is not [fx 0 cx; 0 fy cy; 0 0 1],
 // depth_scale <= 0, non-finite numbers.
 CameraInfo ParseCameraJson(const std::string& text, const std::string& name,
-                           std::optional<double> depth_scale = std::nullopt);
-CameraInfo ReadCameraJson(const std::string& path, std::optional<double> depth_scale = std::nullopt);
+                           std::optional<double> depth_scale = std::nullopt,
+                           std::optional<int> im_id = std::nullopt);
+CameraInfo ReadCameraJson(const std::string& path, std::optional<double> depth_scale = std::nullopt,
+                          std::optional<int> im_id = std::nullopt);
 // A BOP scene_camera.json: {"im_id": {"cam_K": [...], "depth_scale": s, ...}, ...}.
 std::map<int, CameraInfo> ParseSceneCamera(const std::string& text, const std::string& name);
 // --intrinsics fx,fy,cx,cy with --depth-scale S.

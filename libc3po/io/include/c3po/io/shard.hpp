@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "c3po/io/dataset.hpp"
+
 namespace c3po {
 
 struct Shard {
@@ -24,6 +26,12 @@ Shard ParseShard(const std::string& text);
 // (jobs of one group adjacent). Groups g = 0..G-1 in order of appearance; the
 // shard takes groups [floor((K-1) G / N), floor(K G / N)).
 std::vector<std::size_t> ShardJobs(const std::vector<std::int64_t>& group_keys, const Shard& shard);
+
+// The group key of a BOP image (its instances form one group).
+std::int64_t ImageGroupKey(int scene_id, int im_id);
+
+// The K-th part of a dataset, by manifest line (eval --shard on --data).
+Dataset ShardDataset(const Dataset& dataset, const Shard& shard);
 
 // Joins shard outputs given in shard order (name, contents): JSON lines are
 // concatenated (every non-empty line must be a JSON object); BOP CSVs

@@ -22,6 +22,9 @@ std::vector<CloudSource> BopSources(const BopInstances& instances, const Segment
 // --shard K/N (shard.hpp): a BOP image's instances form one group, any other
 // source is a group of its own; parts 1..N concatenated are `sources`.
 std::vector<CloudSource> ShardSources(const std::vector<CloudSource>& sources, const Shard& shard);
+// The same parts of a BOP instance list (eval --shard: instances become a
+// dataset); instances keep pointing into their BopInstances' detections.
+std::vector<BopInstance> ShardBopInstances(const std::vector<BopInstance>& instances, const Shard& shard);
 // BOP results rows (bop.hpp) from a batch: one per BOP source whose
 // registration succeeded; score = CertificateScore with the batch's eps_oc;
 // time = the seconds of all the object's sources of that image.
