@@ -81,6 +81,23 @@ set -e
 [ $status -eq 2 ] || fail "a row of an absent image: expected exit 2, got $status"
 grep -q "no BOP instance of obj_id 5 in scene/image '0/999' (unmatched)" absent.err || fail "unmatched row not named: $(cat absent.err)"
 
+# With --shard, the rows of the other shard's images are skipped (counted), not unmatched;
+# the two shards together give the verdicts of the whole run.
+for k in 1 2; do
+  set +e
+  "$C3PO" certify "$OBJ" --bop bop --obj-id 5 --poses first.csv --no-correct --shard $k/2 --json > shard$k.jsonl 2> shard$k.err
+  status=$?
+  set -e
+  [ $status -le 1 ] || fail "shard $k/2: exit $status ($(cat shard$k.err))"
+  grep -q "line(s) for other shards skipped" shard$k.err || fail "shard $k/2: other shards not reported: $(cat shard$k.err)"
+done
+python3 - again.jsonl shard1.jsonl shard2.jsonl <<'PY2' || fail "shards differ from the whole run"
+import json, sys
+whole = sorted((json.loads(l)["cloud"], json.loads(l)["chosen"]) for l in open(sys.argv[1]))
+parts = sorted((json.loads(l)["cloud"], json.loads(l)["chosen"]) for f in sys.argv[2:] for l in open(f))
+assert whole == parts, (whole, parts)
+PY2
+
 # --bop-csv is not an output of --poses runs.
 set +e; "$C3PO" certify "$OBJ" --bop bop --obj-id 5 --poses first.csv --bop-csv x.csv > both.txt 2>&1; status=$?; set -e
 [ $status -eq 2 ] || fail "--poses with --bop-csv: expected exit 2, got $status"
