@@ -113,7 +113,7 @@ struct RowSummary {
   double percent_certified = 0.0;
   int certified = 0;
   int false_certificates = 0;          // certified with ADD-S >= adds_threshold
-  int false_certificates_hausdorff = 0;   // certified with Hausdorff >= adds_threshold (>= the ADD-S count)
+  int false_certificates_hausdorff = 0;   // certified with Hausdorff >= adds_threshold (NaN counts)
   double max_certified_hausdorff = 0.0;   // over the certified samples (0 when none)
   std::vector<FalseCertificate> worst_false_certificates;   // by ADD-S, descending
 };
