@@ -3,6 +3,7 @@
 // lines or a human table; exit 0 all certified, 1 some not certified, 2 input
 // error. Formatting only: the loop, `--eps-oc auto` and the JSON-lines schema
 // are the library's (c3po/method/certify_batch.hpp).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -70,7 +71,7 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
 }
 
 // The certify JSON line of a given pose, with the hypothesis and the change
-// the correction made appended (docs/design.md "Certifying given poses").
+// the correction made appended (docs/method.md "Certifying poses from any estimator").
 std::string GivenPoseJsonLine(const std::string& cloud, const CloudOutcome& outcome,
                               const PoseHypothesis& pose, bool chosen) {
   std::string line = CertifyJsonLine(cloud, outcome.estimate);
@@ -86,13 +87,40 @@ std::string GivenPoseJsonLine(const std::string& cloud, const CloudOutcome& outc
 
 // c3po certify --poses: every hypothesis matched to a cloud is certified; per
 // instance the certified one with the best fit is chosen (given_poses.hpp).
+// With --shard, `clouds` is this shard's part of `all_clouds`: hypotheses
+// that match only sources of other shards are theirs, not unmatched.
 int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const CertifyBatchOptions& options,
-                  const std::vector<CloudSource>& clouds) {
+                  const std::vector<CloudSource>& clouds, const std::vector<CloudSource>& all_clouds) {
   const std::vector<PoseHypothesis> poses = ReadPoseList(cmd.poses_path);
-  const GivenPoseSources matched = MatchGivenPoses(object, clouds, poses);
+  GivenPoseSources matched = MatchGivenPoses(object, clouds, poses);
+  std::size_t other_shards = 0;
+  if (clouds.size() != all_clouds.size()) {
+    const std::vector<std::size_t> unmatched_anywhere = MatchGivenPoses(object, all_clouds, poses).unmatched;
+    const std::vector<std::size_t> here = matched.unmatched;
+    matched.unmatched.clear();
+    for (std::size_t h : here) {
+      if (std::find(unmatched_anywhere.begin(), unmatched_anywhere.end(), h) != unmatched_anywhere.end()) {
+        matched.unmatched.push_back(h);
+      } else {
+        ++other_shards;
+      }
+    }
+  }
   for (std::size_t h : matched.unmatched) {
-    std::cerr << "c3po certify: " << cmd.poses_path << ": line " << poses[h].line << ": no cloud named '"
-              << PoseMatchKey(poses[h]) << "' (unmatched)\n";
+    const PoseHypothesis& pose = poses[h];
+    std::cerr << "c3po certify: " << cmd.poses_path << ": line " << pose.line << ": "
+              << (pose.cloud.empty() ? "no BOP instance" + (pose.obj_id ? " of obj_id " + std::to_string(*pose.obj_id) : "") +
+                                           " in scene/image '" + PoseMatchKey(pose) + "'"
+                                     : "no cloud named '" + pose.cloud + "'")
+              << " (unmatched)\n";
+  }
+  if (!matched.other_object.empty()) {
+    std::cerr << "c3po certify: " << cmd.poses_path << ": " << matched.other_object.size()
+              << " line(s) for other obj_ids skipped (first: line " << poses[matched.other_object.front()].line
+              << ", obj_id " << *poses[matched.other_object.front()].obj_id << ")\n";
+  }
+  if (other_shards > 0) {
+    std::cerr << "c3po certify: " << cmd.poses_path << ": " << other_shards << " line(s) for other shards skipped\n";
   }
   ProgressBar progress("certify", matched.sources.size());
   const CertifyBatchResult result =
@@ -144,9 +172,10 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
                   v.chosen ? ("certified hypothesis: line " + std::to_string(poses[matched.hypothesis[*v.chosen]].line)).c_str()
                            : "no certified hypothesis");
     }
-    std::printf("instances with a certified pose %d/%zu (hypotheses %zu, unmatched %zu, errors %d)\n",
+    std::printf("instances with a certified pose %d/%zu (hypotheses %zu, unmatched %zu, errors %d; "
+                "%zu of %zu sources had no hypothesis)\n",
                 instances_certified, verdicts.size(), matched.sources.size(), matched.unmatched.size(),
-                errors - static_cast<int>(matched.unmatched.size()));
+                errors - static_cast<int>(matched.unmatched.size()), clouds.size() - verdicts.size(), clouds.size());
   }
   if (errors > 0) return 2;
   return instances_certified == static_cast<int>(verdicts.size()) && !verdicts.empty() ? 0 : 1;
@@ -156,6 +185,9 @@ int Run(const CertifyCommand& cmd) {
   const std::size_t detectors = cmd.detector.models.size() + cmd.detector.detectors.size();
   if (!cmd.poses_path.empty() && detectors != 0) {
     throw InputError("c3po certify", "--poses replaces the detector: give no --model / --detector with it");
+  }
+  if (!cmd.poses_path.empty() && !cmd.bop_csv_path.empty()) {
+    throw InputError("c3po certify", "--bop-csv is not written with --poses (use -o for the JSON lines)");
   }
   if (cmd.poses_path.empty() && detectors != 1) {
     throw InputError("c3po certify", "give exactly one of --model FILE, --detector NAME or --poses FILE");
@@ -192,8 +224,9 @@ int Run(const CertifyCommand& cmd) {
   if (sources.empty()) {
     throw InputError("c3po certify", "no clouds given (CLOUD..., --data DIR, --depth/--mask or --bop DIR)");
   }
+  const std::vector<CloudSource> all_sources = shard && !cmd.poses_path.empty() ? sources : std::vector<CloudSource>{};
   if (shard) sources = ShardSources(sources, *shard);
-  if (!cmd.poses_path.empty()) return RunGivenPoses(cmd, object, options, sources);
+  if (!cmd.poses_path.empty()) return RunGivenPoses(cmd, object, options, sources, shard ? all_sources : sources);
   LoadPlugins(cmd.detector);
   const std::unique_ptr<Detector> detector =
       MakeDetector(cmd.detector.models.empty() ? "" : cmd.detector.models.front(),
@@ -254,7 +287,7 @@ RunFunction SetupCertify(CLI::App& command) {
                    "Certify the plain registration of the detected keypoints (with --poses: the given pose as is)");
   command.add_option("--poses", cmd->poses_path,
                      "Certify these poses (BOP results CSV or JSON lines with cloud, R, t) instead of detecting; "
-                     "matched to the clouds by name (docs/design.md)");
+                     "matched to the clouds by name, BOP rows to every instance of their obj_id in their image (docs/method.md)");
   AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);
   AddFrameOptions(command, &cmd->frame);

@@ -35,6 +35,21 @@ double DistanceToSet(const Eigen::Vector3d& q, const PointSet& points) {
   return (points.colwise() - q).colwise().norm().minCoeff();
 }
 
+// max_i min_j ||a_i - b_j||, by brute force.
+double MaxNearest(const PointSet& a, const PointSet& b) {
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < a.cols(); ++i) worst = std::max(worst, DistanceToSet(a.col(i), b));
+  return worst;
+}
+
+// The symmetric Hausdorff distance between the model posed at the truth and
+// at the estimate, 2000 strided points of B̂ against all of B̂ (both ways).
+double BruteHausdorff(const ObjectModel& object, const Pose& truth, const Pose& estimate) {
+  const PointSet queries = StridedColumns(object.sample(), 2000);
+  return std::max(MaxNearest(truth * queries, estimate * object.sample()),
+                  MaxNearest(estimate * queries, truth * object.sample()));
+}
+
 // oc and nd of an estimate by brute force (docs/method.md "Certificates").
 std::pair<bool, bool> BruteCertificate(const ObjectModel& object, const PointSet& cloud, const Pose& estimate,
                                        const PointSet& keypoints, double eps_oc, double delta_nd) {
@@ -106,6 +121,11 @@ std::vector<double> CheckSamples(const Fixture& f, const EvaluationRow& row, con
                                            options.pipeline.certificate.eps_oc, options.pipeline.certificate.delta_nd);
     CHECK(s.oc == oc);
     CHECK(s.nd == nd);
+    if (s.certified()) {
+      CHECK(s.hausdorff == doctest::Approx(BruteHausdorff(f.object, truth, s.scene_from_model)).epsilon(1e-9));
+    } else {
+      CHECK(std::isnan(s.hausdorff));
+    }
     adds.push_back(expected);
   }
   return adds;
@@ -121,7 +141,8 @@ void CheckSummary(const EvaluationRow& row, const std::vector<double>& adds, con
   CHECK(s.adds_score == doctest::Approx(100.0 * below / n));
   CHECK(s.adds_auc == doctest::Approx(NumericAuc(adds, options.auc_max)).epsilon(1e-3));
   std::vector<double> rotation, translation;
-  int oc = 0, nd = 0, certified = 0, false_certificates = 0;
+  int oc = 0, nd = 0, certified = 0, false_certificates = 0, false_hausdorff = 0;
+  double max_hausdorff = 0.0;
   for (std::size_t k = 0; k < row.samples.size(); ++k) {
     const SampleResult& sample = row.samples[k];
     // (each rotation error was checked against the brute force in CheckSamples)
@@ -131,6 +152,11 @@ void CheckSummary(const EvaluationRow& row, const std::vector<double>& adds, con
     nd += sample.nd;
     certified += sample.oc && sample.nd;
     false_certificates += sample.oc && sample.nd && !(adds[k] < options.adds_threshold);
+    if (sample.oc && sample.nd) {
+      // (each Hausdorff distance was checked against the brute force in CheckSamples)
+      false_hausdorff += !(sample.hausdorff < options.adds_threshold);
+      max_hausdorff = std::max(max_hausdorff, sample.hausdorff);
+    }
   }
   CHECK(s.median_rotation_error == doctest::Approx(SortedMedian(rotation)));
   CHECK(s.median_translation_error_over_d == doctest::Approx(SortedMedian(translation) / diameter));
@@ -138,6 +164,8 @@ void CheckSummary(const EvaluationRow& row, const std::vector<double>& adds, con
   CHECK(s.percent_nd == doctest::Approx(100.0 * nd / n));
   CHECK(s.percent_certified == doctest::Approx(100.0 * certified / n));
   CHECK(s.false_certificates == false_certificates);
+  CHECK(s.false_certificates_hausdorff == false_hausdorff);
+  CHECK(s.max_certified_hausdorff == max_hausdorff);
 }
 
 }  // namespace
@@ -250,10 +278,14 @@ TEST_CASE("loose certificate thresholds produce false certificates that are coun
   CHECK(keypo.summary.worst_false_certificates[0].adds == doctest::Approx(wrong[0]));
   CHECK(keypo.summary.worst_false_certificates[1].adds == doctest::Approx(wrong[1]));
   CHECK(e.total_false_certificates() >= 3);
+  CHECK(keypo.summary.false_certificates_hausdorff >= 3);   // a 90-degree turn moves the model by more than 5 % d
+  CHECK(keypo.summary.max_certified_hausdorff > options.adds_threshold);
   const std::string table = EvaluationTable(e);
   CHECK(table.find("Soundness: " + std::to_string(e.total_false_certificates()) + " false certificates") !=
         std::string::npos);
   CHECK(table.find("ADD-S variant: symmetric") != std::string::npos);
+  CHECK(table.find("Hausdorff check: " + std::to_string(e.total_false_certificates_hausdorff()) +
+                   " certified outputs") != std::string::npos);
 }
 
 TEST_CASE("Summarize: empty subsets, failures and the false-certificate order") {
@@ -273,12 +305,17 @@ TEST_CASE("Summarize: empty subsets, failures and the false-certificate order") 
     samples[k].adds = adds[k];
     samples[k].oc = samples[k].nd = k < 3;
   }
+  samples[0].hausdorff = 0.9;   // certified, ADD-S fine, Hausdorff fine
+  samples[1].hausdorff = 4.0;
+  // samples[2]: certified without a Hausdorff distance (NaN) counts as false
   samples[3].error = "registration failed";
   const RowSummary s = Summarize(samples, options, 1.0);
   CHECK(s.failures == 1);
   CHECK(s.adds_score == doctest::Approx(25.0));               // only 0.5 < 1 (strict)
   CHECK(s.adds_auc == doctest::Approx(NumericAuc({0.5, 3.0, 1.0, INFINITY}, 2.0)).epsilon(1e-3));
   CHECK(s.false_certificates == 2);                          // 3.0 and 1.0 (not below 1.0)
+  CHECK(s.false_certificates_hausdorff == 2);                // 4.0 and NaN
+  CHECK(s.max_certified_hausdorff == 4.0);
   REQUIRE(s.worst_false_certificates.size() == 2);
   CHECK(s.worst_false_certificates[0].cloud == "c1");
   CHECK(s.worst_false_certificates[1].cloud == "c2");

@@ -157,3 +157,68 @@ TEST_CASE("Given poses are certified as they are: only the right one passes, and
     }
   }
 }
+
+TEST_CASE("BOP rows (no gt_id) are hypotheses for every instance of their object in their image") {
+  ObjectModel object = test::AsymmetricObject();
+  object.mutable_spec().indicator_sets = {{0, 1, 2, 3, 4}};
+  object.mutable_spec().eps_oc = 0.012;
+  object.mutable_spec().delta_nd = 0.015;
+  Rng rng(11);
+  // Two instances of obj 5 in scene 0 image 1 (apart), one in image 2.
+  const std::vector<Pose> truth = {{rng.Rotation(), Eigen::Vector3d(-0.3, 0.0, 1.0)},
+                                   {rng.Rotation(), Eigen::Vector3d(0.3, 0.05, 1.2)},
+                                   {rng.Rotation(), Eigen::Vector3d(0.0, 0.0, 0.9)}};
+  std::vector<PointSet> clouds;
+  for (const Pose& pose : truth) clouds.push_back(pose * SampleSurface(object.mesh(), 6000, 3));
+  std::vector<CloudSource> sources = InMemorySources(clouds);
+  const int image[] = {1, 1, 2}, gt[] = {0, 1, 0};
+  for (int k = 0; k < 3; ++k) {
+    CloudProvenance provenance;
+    provenance.scene_id = 0;
+    provenance.im_id = image[k];
+    provenance.gt_id = gt[k];
+    provenance.obj_id = 5;
+    sources[k].provenance = provenance;
+  }
+  const std::string csv = "scene_id,im_id,obj_id,score,R,t,time\n" + Row(truth[0], 0, 1, 5, 0.4) +
+                          Row(truth[1], 0, 1, 5, 0.9) + Row(truth[2], 0, 2, 5, 0.5) +
+                          Row(truth[0], 0, 1, 9, 1.0) +   // another object: skipped, listed
+                          Row(truth[2], 0, 3, 5, 1.0);    // no such image: unmatched
+  const std::vector<PoseHypothesis> poses = ParsePoseList(csv, "rows.csv");
+  REQUIRE(poses.size() == 5);
+  const GivenPoseSources matched = MatchGivenPoses(object, sources, poses);
+  // Rows 0 and 1 on both instances of image 1, row 2 on image 2's instance.
+  REQUIRE(matched.sources.size() == 5);
+  CHECK(matched.hypothesis == std::vector<std::size_t>{0, 0, 1, 1, 2});
+  CHECK(matched.instance == std::vector<std::size_t>{0, 1, 0, 1, 2});
+  CHECK(matched.other_object == std::vector<std::size_t>{3});
+  CHECK(matched.unmatched == std::vector<std::size_t>{4});
+
+  CertifyBatchOptions options;
+  options.pipeline.correct = false;
+  options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
+  const CertifyBatchResult result = CertifyBatch(object, matched.sources, nullptr, options);
+  for (std::size_t s = 0; s < matched.sources.size(); ++s) {
+    CAPTURE(s);
+    const bool own = matched.hypothesis[s] == matched.instance[s];   // row k is instance k's pose here
+    const double hausdorff = HausdorffDistance(truth[matched.instance[s]] * object.sample(),
+                                               poses[matched.hypothesis[s]].scene_from_model * object.sample());
+    CHECK(result.outcomes[s].certified() == own);
+    if (result.outcomes[s].certified()) CHECK(hausdorff < 0.05 * object.diameter());
+  }
+  const auto verdicts = ChooseCertified(matched, poses, result);
+  REQUIRE(verdicts.size() == 3);
+  for (const auto& verdict : verdicts) {
+    CAPTURE(verdict.instance);
+    REQUIRE(verdict.chosen);
+    CHECK(matched.hypothesis[*verdict.chosen] == verdict.instance);   // its own row, whatever the scores
+  }
+
+  SUBCASE("without BOP sources a row with ids is unmatched, not another object's") {
+    const std::vector<CloudSource> plain = InMemorySources(clouds);
+    const GivenPoseSources none = MatchGivenPoses(object, plain, poses);
+    CHECK(none.sources.empty());
+    CHECK(none.other_object.empty());
+    CHECK(none.unmatched.size() == poses.size());
+  }
+}

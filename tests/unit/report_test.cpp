@@ -142,6 +142,11 @@ TEST_CASE("the report is well-formed, self-contained HTML with the table, soundn
   for (const auto& row : f.evaluation.rows) CHECK(table.find(">" + row.label + "<") != std::string::npos);
   CHECK(html.find("<b id=\"false-certificates\">" + std::to_string(f.evaluation.total_false_certificates()) + "</b>") !=
         std::string::npos);
+  CHECK(html.find("<b id=\"false-certificates-hausdorff\">" +
+                  std::to_string(f.evaluation.total_false_certificates_hausdorff()) + "</b>") != std::string::npos);
+  const bool sound = f.evaluation.total_false_certificates() == 0 && f.evaluation.total_false_certificates_hausdorff() == 0;
+  CHECK(html.find(sound ? "<section id=\"soundness\" class=\"sound\">" : "<section id=\"soundness\" class=\"unsound\">") !=
+        std::string::npos);
   CHECK(html.find("ADD-S variant: <b>symmetric</b>") != std::string::npos);
   CHECK(html.find("&lt;dir&gt; &amp; more") != std::string::npos);
 

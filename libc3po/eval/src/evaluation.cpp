@@ -47,6 +47,10 @@ void ScoreAgainstTruth(const ObjectModel& object, const Pose& truth, const Evalu
   sample->adds = AddS(object.tree(), truth, sample->scene_from_model, options.adds_variant);
   sample->rotation_error = RotationError(sample->scene_from_model.R, truth.R);
   sample->translation_error = TranslationError(sample->scene_from_model.t, truth.t);
+  if (sample->certified()) {
+    sample->hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000), truth,
+                                            sample->scene_from_model);
+  }
 }
 
 SampleResult FromEstimate(std::size_t index, const std::string& cloud, const PoseEstimate& estimate) {
@@ -261,6 +265,14 @@ int Evaluation::total_false_certificates() const {
   return total;
 }
 
+int Evaluation::total_false_certificates_hausdorff() const {
+  int total = 0;
+  for (const auto& row : rows) {
+    if (row.subset == EvalSubset::kAll) total += row.summary.false_certificates_hausdorff;
+  }
+  return total;
+}
+
 const EvaluationRow* Evaluation::MainRow() const {
   for (const auto& row : rows) {
     if (row.method == EvalMethod::kC3po && row.subset == EvalSubset::kAll) return &row;
@@ -304,6 +316,12 @@ RowSummary Summarize(const std::vector<SampleResult>& samples, const EvaluationO
     oc += s.oc;
     nd += s.nd;
     summary.certified += s.certified();
+    if (s.certified()) {
+      summary.false_certificates_hausdorff += !(s.hausdorff < options.adds_threshold);
+      if (std::isfinite(s.hausdorff)) {
+        summary.max_certified_hausdorff = std::max(summary.max_certified_hausdorff, s.hausdorff);
+      }
+    }
     if (s.certified() && !(s.adds < options.adds_threshold)) {
       false_certificates.push_back({s.index, s.cloud, s.adds, s.rotation_error, s.translation_error});
     }

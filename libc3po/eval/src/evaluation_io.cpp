@@ -92,6 +92,13 @@ std::string SoundnessLines(const Evaluation& e) {
     }
     out << "\n";
   }
+  out << "Hausdorff check: " << e.total_false_certificates_hausdorff() << " certified outputs over all rows with a Hausdorff distance >= "
+      << Format("%.6g", e.options.adds_threshold) << " between the model posed at the truth and at the estimate.\n";
+  for (const auto& row : e.rows) {
+    if (row.subset != EvalSubset::kAll || row.summary.false_certificates_hausdorff == 0) continue;
+    out << "  " << row.label << ": " << row.summary.false_certificates_hausdorff << " of " << row.summary.certified
+        << " certified; largest Hausdorff " << Format("%.4g", row.summary.max_certified_hausdorff) << "\n";
+  }
   return out.str();
 }
 
@@ -122,6 +129,7 @@ json SampleJson(const SampleResult& s) {
   j["nd"] = s.nd;
   j["certified"] = s.certified();
   j["oc_distance"] = Number(s.oc_distance);
+  if (s.certified()) j["hausdorff"] = Number(s.hausdorff);
   j["ms"] = s.milliseconds;
   if (s.ok()) {
     const Pose& T = s.scene_from_model;
@@ -145,6 +153,8 @@ json SummaryJson(const RowSummary& s, double diameter) {
   j["percent_certified"] = Number(s.percent_certified);
   j["certified"] = s.certified;
   j["false_certificates"] = s.false_certificates;
+  j["false_certificates_hausdorff"] = s.false_certificates_hausdorff;
+  j["max_certified_hausdorff"] = Number(s.max_certified_hausdorff);
   json worst = json::array();
   for (const auto& f : s.worst_false_certificates) {
     worst.push_back({{"cloud", f.cloud}, {"index", f.index}, {"adds", Number(f.adds)},
@@ -206,6 +216,7 @@ std::string EvaluationJson(const Evaluation& e) {
               {"max_correspondence_distance", Number(o.icp.max_correspondence_distance)},
               {"trim_fraction", o.icp.trim_fraction}};
   j["false_certificates"] = e.total_false_certificates();
+  j["false_certificates_hausdorff"] = e.total_false_certificates_hausdorff();
   json rows = json::array();
   for (const auto& row : e.rows) {
     json r;

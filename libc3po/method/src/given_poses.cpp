@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
+#include <utility>
 #include <unordered_map>
 
 namespace c3po {
@@ -16,20 +18,51 @@ std::string PoseMatchKey(const PoseHypothesis& pose) {
 GivenPoseSources MatchGivenPoses(const ObjectModel& object, const std::vector<CloudSource>& clouds,
                                  const std::vector<PoseHypothesis>& poses) {
   std::unordered_map<std::string, std::size_t> by_name;
-  for (std::size_t i = 0; i < clouds.size(); ++i) by_name.emplace(clouds[i].name, i);   // first wins
-  GivenPoseSources matched;
-  for (std::size_t h = 0; h < poses.size(); ++h) {
-    const auto it = by_name.find(PoseMatchKey(poses[h]));
-    if (it == by_name.end()) {
-      matched.unmatched.push_back(h);
-      continue;
+  std::map<std::pair<int, int>, std::vector<std::size_t>> by_image;   // BOP sources of (scene_id, im_id)
+  std::set<int> obj_ids;                                              // of the BOP sources
+  for (std::size_t i = 0; i < clouds.size(); ++i) {
+    by_name.emplace(clouds[i].name, i);   // first wins
+    if (const auto& p = clouds[i].provenance) {
+      by_image[{p->scene_id, p->im_id}].push_back(i);
+      obj_ids.insert(p->obj_id);
     }
-    CloudSource source = clouds[it->second];
+  }
+  GivenPoseSources matched;
+  const auto add = [&](std::size_t h, std::size_t i) {
+    CloudSource source = clouds[i];
     source.name += " (line " + std::to_string(poses[h].line) + ")";
     source.given_keypoints = poses[h].scene_from_model * object.keypoints();
     matched.sources.push_back(std::move(source));
     matched.hypothesis.push_back(h);
-    matched.instance.push_back(it->second);
+    matched.instance.push_back(i);
+  };
+  for (std::size_t h = 0; h < poses.size(); ++h) {
+    const PoseHypothesis& pose = poses[h];
+    if (!pose.cloud.empty()) {
+      const auto it = by_name.find(pose.cloud);
+      if (it == by_name.end()) {
+        matched.unmatched.push_back(h);
+      } else {
+        add(h, it->second);
+      }
+      continue;
+    }
+    if (pose.obj_id && !obj_ids.empty() && obj_ids.count(*pose.obj_id) == 0) {
+      matched.other_object.push_back(h);
+      continue;
+    }
+    bool any = false;
+    if (pose.scene_id && pose.im_id) {
+      const auto it = by_image.find({*pose.scene_id, *pose.im_id});
+      if (it != by_image.end()) {
+        for (std::size_t i : it->second) {
+          if (pose.obj_id && clouds[i].provenance->obj_id != *pose.obj_id) continue;
+          add(h, i);
+          any = true;
+        }
+      }
+    }
+    if (!any) matched.unmatched.push_back(h);
   }
   return matched;
 }

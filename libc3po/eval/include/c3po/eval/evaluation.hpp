@@ -25,6 +25,7 @@
 // below the ADD-S threshold; every row counts them and lists the worst.
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,10 @@ struct SampleResult {
   bool oc = false;
   bool nd = false;
   double oc_distance = 0.0;            // max_x min_p ||x - p|| (evidence of oc)
+  // Certified samples only (NaN otherwise): the symmetric Hausdorff distance
+  // between the model posed at the truth and at T̂ (PosedModelHausdorff, 2000
+  // points of B̂), the pose error a certificate must bound (symmetries free).
+  double hausdorff = std::numeric_limits<double>::quiet_NaN();
   std::vector<int> outlier_indices;    // input points at >= eps_oc (oc_m's outliers, ascending)
   double milliseconds = 0.0;           // estimation + certification time of this method
   bool ok() const { return error.empty(); }
@@ -108,6 +113,8 @@ struct RowSummary {
   double percent_certified = 0.0;
   int certified = 0;
   int false_certificates = 0;          // certified with ADD-S >= adds_threshold
+  int false_certificates_hausdorff = 0;   // certified with Hausdorff >= adds_threshold (NaN counts)
+  double max_certified_hausdorff = 0.0;   // over the certified samples (0 when none)
   std::vector<FalseCertificate> worst_false_certificates;   // by ADD-S, descending
 };
 
@@ -128,6 +135,7 @@ struct Evaluation {
   EvaluationOptions options;           // absolute thresholds used
   std::vector<EvaluationRow> rows;
   int total_false_certificates() const;
+  int total_false_certificates_hausdorff() const;
   // The row whose examples a report shows: the first C-3PO row on all clouds,
   // else the first corrector row, else the first row; nullptr without rows.
   const EvaluationRow* MainRow() const;

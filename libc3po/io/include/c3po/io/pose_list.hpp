@@ -1,6 +1,6 @@
 #pragma once
-// Poses from any estimator, for `c3po certify --poses FILE` (docs/design.md
-// "Certifying given poses"). Two formats, told apart by the first non-blank
+// Poses from any estimator, for `c3po certify --poses FILE` (docs/method.md
+// "Certifying poses from any estimator"). Two formats, told apart by the first non-blank
 // character ('{' = JSON lines, anything else = BOP CSV):
 //   BOP results CSV (BOP toolkit): header `scene_id,im_id,obj_id,score,R,t,time`,
 //     R = 9 numbers row-major separated by spaces, t = 3 numbers in mm,
