@@ -54,6 +54,7 @@ std::vector<SampleResult> Samples(std::uint64_t seed, int n) {
       s.oc = rng.Uniform(0.0, 1.0) < 0.6;
       s.nd = rng.Uniform(0.0, 1.0) < 0.7;
       s.oc_distance = rng.Uniform(0.0, 0.02);
+      if (s.oc && s.nd) s.hausdorff = rng.Uniform(0.0, 0.06) / 3.0;   // some at or above adds_threshold
       s.scene_from_model.R = Eigen::AngleAxisd(rng.Uniform(0.0, 3.0), Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
       s.scene_from_model.t = Eigen::Vector3d(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(0.5, 2)) / 3.0;
     }
@@ -110,6 +111,7 @@ TEST_CASE("merged sample files of contiguous parts give the whole evaluation's t
   const std::vector<std::vector<SampleResult>> all = {Samples(1, n), Samples(2, n), Samples(3, n)};
   const Evaluation whole = Slice(all, 0, n);
   REQUIRE(whole.total_false_certificates() > 0);   // the listing with global indices is exercised
+  REQUIRE(whole.total_false_certificates_hausdorff() > 0);   // and the Hausdorff check
   for (const std::vector<std::size_t>& cuts : std::vector<std::vector<std::size_t>>{{0, 23}, {0, 8, 23}, {0, 1, 9, 22, 23}}) {
     std::vector<std::pair<std::string, std::string>> parts;
     const int count = static_cast<int>(cuts.size()) - 1;

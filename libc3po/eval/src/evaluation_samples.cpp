@@ -161,6 +161,7 @@ json SampleLine(int row, const SampleResult& s) {
   j["oc"] = s.oc;
   j["nd"] = s.nd;
   j["oc_distance"] = Exact(s.oc_distance);
+  j["hausdorff"] = Exact(s.hausdorff);   // NaN unless certified (eval's Hausdorff check)
   j["ms"] = Exact(s.milliseconds);
   if (s.ok()) SetPoseJson(s.scene_from_model, &j);
   return j;
@@ -195,6 +196,7 @@ SampleResult ReadSample(const json& line, const std::string& where) {
   s.oc = Bool(line, "oc", where);
   s.nd = Bool(line, "nd", where);
   s.oc_distance = Number(line, "oc_distance", where);
+  s.hausdorff = Number(line, "hausdorff", where);
   s.milliseconds = Number(line, "ms", where);
   if (s.ok()) s.scene_from_model = ReadPose(line, where);
   return s;
