@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <stdexcept>
@@ -290,18 +291,47 @@ bool Better(const ValidationFit& candidate, const ValidationFit& best, double re
 SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
                           TrainableDetector& detector, const SelfTrainOptions& options,
                           const EpochCallback& on_epoch, const ProgressCallback& progress,
-                          bool resume, const SelfTrainReference* reference) {
+                          bool resume, const SelfTrainReference* reference, const std::vector<int>* groups) {
   options.Check();
   if (clouds.size() < 2) throw InputError("selftrain", "need at least 2 unlabelled clouds");
   if (reference != nullptr && reference->scene_from_model.size() != clouds.size()) {
     throw std::invalid_argument("SelfTrain: reference poses must match the clouds");
   }
+  if (groups != nullptr && groups->size() != clouds.size()) {
+    throw std::invalid_argument("SelfTrain: groups must match the clouds");
+  }
   // Deterministic split: a seeded shuffle, the first part held out.
   std::vector<int> all(clouds.size());
   std::iota(all.begin(), all.end(), 0);
   all = Shuffled(all, Rng::ForItem(options.seed, 0xC3B0));
-  const std::size_t validation_count = std::clamp<std::size_t>(
+  std::size_t validation_count = std::clamp<std::size_t>(
       static_cast<std::size_t>(std::lround(options.validation_fraction * clouds.size())), 1, clouds.size() - 1);
+  if (groups != nullptr) {
+    // Split by group (e.g. by image: the augmented copies of one real
+    // instance, and the instances of one image, are never on both sides):
+    // whole groups in a seeded order are held out until the validation part
+    // reaches its size; at least one group is held out and one trained on.
+    std::vector<int> distinct(groups->begin(), groups->end());
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    if (distinct.size() < 2) {
+      throw InputError("selftrain", "the clouds come from one image: need at least 2 to split into training and "
+                                    "validation");
+    }
+    distinct = Shuffled(distinct, Rng::ForItem(options.seed, 0xC3B0));
+    std::vector<std::vector<int>> members(distinct.size());
+    std::map<int, std::size_t> rank_of;
+    for (std::size_t r = 0; r < distinct.size(); ++r) rank_of[distinct[r]] = r;
+    for (int i : all) members[rank_of.at((*groups)[i])].push_back(i);
+    const std::size_t target = validation_count;
+    all.clear();
+    validation_count = 0;
+    for (std::size_t r = 0; r < members.size(); ++r) {
+      const bool held_out = r == 0 || (validation_count < target && r + 1 < members.size());
+      if (held_out) validation_count += members[r].size();
+      all.insert(all.end(), members[r].begin(), members[r].end());
+    }
+  }
   std::vector<PointSet> validation;
   std::vector<Pose> validation_truth;
   for (std::size_t k = 0; k < validation_count; ++k) {
