@@ -19,6 +19,7 @@ namespace {
 struct MergeCommand {
   std::vector<std::string> parts;
   std::string output_path;
+  bool prefix_parts = false;
 };
 
 bool IsCsv(const std::string& path) { return path.size() >= 4 && path.compare(path.size() - 4, 4, ".csv") == 0; }
@@ -26,7 +27,7 @@ bool IsCsv(const std::string& path) { return path.size() >= 4 && path.compare(pa
 int Run(const MergeCommand& cmd) {
   std::error_code ec;
   if (std::filesystem::is_directory(cmd.parts.front(), ec)) {   // dataset folders (synth --shard)
-    const std::size_t clouds = MergeDatasets(cmd.parts, cmd.output_path);
+    const std::size_t clouds = MergeDatasets(cmd.parts, cmd.output_path, cmd.prefix_parts);
     std::printf("wrote %s: %zu clouds from %zu parts\n", cmd.output_path.c_str(), clouds, cmd.parts.size());
     return 0;
   }
@@ -46,9 +47,13 @@ RunFunction SetupMerge(CLI::App& command) {
   auto cmd = std::make_shared<MergeCommand>();
   command.add_option("parts", cmd->parts, "Outputs of --shard 1/N .. N/N, in that order (files, or synth's dataset folders)")->required();
   command.add_option("-o,--output", cmd->output_path, "Merged file (.csv: BOP CSV, one header; else JSON lines) or dataset folder")->required();
+  command.add_flag("--prefix-parts", cmd->prefix_parts,
+                   "Datasets: put each part's clouds under a folder named after the part (joins datasets with the "
+                   "same cloud names, e.g. several objects' clouds into a mixed dataset)");
   command.footer("Example:\n  parallel c3po certify obj.json --bop DIR --obj-id 5 --detector svd -o part{}.jsonl --bop-csv part{}.csv "
                  "--shard {}/4 ::: 1 2 3 4\n  c3po merge -o poses.jsonl part{1..4}.jsonl && c3po merge -o results.csv part{1..4}.csv\n"
-                 "  c3po synth obj.json -o sim_{} --kind sim --count 1000 --shard {}/4 ...; c3po merge -o sim sim_1 sim_2 sim_3 sim_4");
+                 "  c3po synth obj.json -o sim_{} --kind sim --count 1000 --shard {}/4 ...; c3po merge -o sim sim_1 sim_2 sim_3 sim_4\n"
+                 "  c3po merge --prefix-parts -o mixed drill_depth mug_depth   # a mixed dataset (manifest \"object\" labels)");
   return [cmd]() { return Run(*cmd); };
 }
 

@@ -2,8 +2,10 @@
 // unlabelled clouds (paper Section VI-C): only observably correct outputs
 // teach the detector, with their corrected keypoints as targets.
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
@@ -65,6 +67,7 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
       data.groups.push_back(static_cast<int>(i));
       data.truth.push_back(dataset.entries[i].pose);
       data.names.push_back(dataset.entries[i].cloud);
+      data.labels.push_back(dataset.entries[i].object.value_or(""));
     }
     if (cmd.augment.copies > 1) data = Augment(data, cmd.augment);
   }
@@ -102,6 +105,7 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
       data.groups.push_back(camera.groups[i] + offset);
       data.truth.push_back(camera.truth[i]);
       data.names.push_back(camera.names[i]);
+      data.labels.push_back(camera.labels[i]);
     }
   }
   return data;
@@ -147,7 +151,10 @@ int Run(SelftrainCommand cmd) {
   // Ground truth, when every cloud has it, only feeds the log's reporting
   // columns (rotation error, Hausdorff distance); selection never reads it.
   std::optional<SelfTrainReference> reference;
-  if (data.AllHaveTruth()) {
+  // Another object's truth is not this object's: no reporting columns on a mixed set.
+  const bool mixed = std::any_of(data.labels.begin(), data.labels.end(),
+                                 [&](const std::string& label) { return !label.empty() && label != object.name(); });
+  if (data.AllHaveTruth() && !mixed) {
     reference.emplace();
     for (const auto& truth : data.truth) reference->scene_from_model.push_back(*truth);
   }
@@ -208,6 +215,23 @@ int Run(SelftrainCommand cmd) {
                      {"best_validation_residual_q50", result.best.residual_q50},
                      {"stopped_early", result.stopped_early}}}};
   if (!eps_oc_evidence.empty()) extra["selftrain"]["eps_oc_auto"] = nlohmann::json::parse(eps_oc_evidence);
+  if (mixed) {
+    // Per object label: clouds, clouds whose pseudo-label was trained on, training uses.
+    std::map<std::string, std::array<long, 3>> by_label;
+    for (std::size_t i = 0; i < clouds.size(); ++i) {
+      auto& counts = by_label[data.labels[i].empty() ? "(unlabelled)" : data.labels[i]];
+      counts[0] += 1;
+      counts[1] += result.pseudo_label_uses[i] > 0;
+      counts[2] += result.pseudo_label_uses[i];
+    }
+    nlohmann::json table = nlohmann::json::object();
+    for (const auto& [label, counts] : by_label) {
+      table[label] = {{"clouds", counts[0]}, {"trained_on", counts[1]}, {"uses", counts[2]}};
+      std::printf("pseudo-labels from %s clouds%s: %ld of %ld clouds trained on (%ld uses)\n", label.c_str(),
+                  label == object.name() ? " (this object)" : "", counts[1], counts[0], counts[2]);
+    }
+    extra["selftrain"]["pseudo_labels_by_object"] = table;
+  }
   detector->Save(cmd.output_path, extra.dump());
   std::printf("wrote %s: validation %% oc %.1f -> %.1f, %% identified %.1f -> %.1f, residual q50 %.3g -> %.3g "
               "(best epoch %d%s); eps_oc = %.6g; log %s\n",

@@ -223,7 +223,8 @@ struct EpochStats {
 EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clouds,
                     const std::vector<int>& order, TrainableDetector& detector,
                     const SelfTrainOptions& options, const ProgressCallback& progress,
-                    std::size_t progress_offset, std::size_t progress_total, int epoch) {
+                    std::size_t progress_offset, std::size_t progress_total, int epoch,
+                    std::vector<int>* pseudo_label_uses) {
   EpochStats stats;
   const PrincipalFrame frame = ModelPrincipalFrame(object);
   for (std::size_t start = 0; start < order.size(); start += options.batch) {
@@ -248,6 +249,7 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
       stats.certified += estimates[i].ok() && estimates[i].certificate.oc.passed;
       stats.ambiguous += ambiguous[i];
       if (usable[i]) {
+        ++(*pseudo_label_uses)[static_cast<std::size_t>(order[start + i])];
         certified_clouds.push_back(batch[i]);
         targets.push_back(estimates[i].keypoints);   // pseudo-label: corrected keypoints
       }
@@ -345,6 +347,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   };
 
   SelfTrainResult result;
+  result.pseudo_label_uses.assign(clouds.size(), 0);
   std::vector<float> best_weights;
   int first_epoch = 1;
   int stale = 0;   // epochs in a row without a new best
@@ -360,6 +363,9 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     result.best = FitFromJson(state.at("best"));
     stale = state.at("stale");
     for (const auto& log : state.at("logs")) result.epochs.push_back(LogFromJson(log));
+    if (state.contains("pseudo_label_uses") && state.at("pseudo_label_uses").size() == clouds.size()) {
+      state.at("pseudo_label_uses").get_to(result.pseudo_label_uses);
+    }
     best_weights = LoadWeights(best_path, detector.GetWeights().size());
   } else {
     result.initial = measure();
@@ -382,7 +388,8 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     const auto start = std::chrono::steady_clock::now();
     const std::vector<int> order = Shuffled(train, Rng::ForItem(options.seed, epoch));
     const EpochStats stats = RunEpoch(object, clouds, order, detector, options, progress,
-                                      train.size() * (epoch - 1), progress_total, epoch);
+                                      train.size() * (epoch - 1), progress_total, epoch,
+                                      &result.pseudo_label_uses);
     if (epoch == 1 && stats.certified == 0) {
       throw InputError("selftrain", "no training cloud was observably correct in the first epoch: nothing to "
                                     "learn from (check eps_oc, the object, or train the detector on sim data first)");
@@ -426,7 +433,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
                     {"best_validation_detection_error", result.best_validation_detection_error},
                     {"initial_validation_percent_oc", result.initial_validation_percent_oc},
                     {"initial", FitJson(result.initial)}, {"best", FitJson(result.best)}, {"stale", stale},
-                    {"logs", json::array()}};
+                    {"logs", json::array()}, {"pseudo_label_uses", result.pseudo_label_uses}};
       for (const auto& l : result.epochs) state["logs"].push_back(LogJson(l));
       SaveWeights(best_path, best_weights);
       detector.SaveCheckpoint(options.checkpoint_path, state.dump());

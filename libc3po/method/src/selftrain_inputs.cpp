@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <numeric>
 #include <stdexcept>
@@ -58,6 +59,9 @@ UnlabelledClouds LoadUnlabelledClouds(const std::vector<CloudSource>& sources) {
     result.groups.push_back(group);
     result.truth.push_back(sources[i].scene_from_model_truth);
     result.names.push_back(sources[i].name);
+    char label[32] = "";
+    if (sources[i].provenance) std::snprintf(label, sizeof label, "obj_%06d", sources[i].provenance->obj_id);
+    result.labels.push_back(label);
   }
   return result;
 }
@@ -99,6 +103,7 @@ UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions
     result.groups.push_back(instances.groups[i]);
     result.truth.push_back(instances.truth[i]);
     result.names.push_back(instances.names[i] + "#" + std::to_string(k % copies));
+    result.labels.push_back(instances.labels[i]);
   }
   return result;
 }

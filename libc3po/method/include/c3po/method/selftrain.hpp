@@ -86,6 +86,10 @@ struct SelfTrainResult {
   ValidationFit initial;              // the model before self-training
   ValidationFit best;                 // the kept model
   bool stopped_early = false;
+  // Per cloud (input order): how many training steps used its pseudo-label
+  // (0 for held-out clouds and for clouds never certified unambiguously):
+  // the evidence that, in mixed data, another object's clouds taught nothing.
+  std::vector<int> pseudo_label_uses;
 };
 
 // Optional ground truth for reporting (same length as the clouds); selection

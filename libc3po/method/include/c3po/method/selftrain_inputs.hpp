@@ -28,11 +28,16 @@ struct AugmentOptions {
 // Unlabelled clouds with their provenance. groups[i]: the validation unit of
 // clouds[i] (one per image for BOP sources, keyed (scene_id, im_id); one per
 // source otherwise). truth[i]: the source's ground truth (reporting only).
+// labels[i]: the object the cloud shows when known ("obj_000005" for a BOP
+// instance of obj_id 5, the name annotate gives models/obj_000005.ply; a
+// manifest's "object"), "" otherwise; never used for training, only to
+// report what a mixed dataset's clouds of each object taught.
 struct UnlabelledClouds {
   std::vector<PointSet> clouds;
   std::vector<int> groups;
   std::vector<std::optional<Pose>> truth;
   std::vector<std::string> names;
+  std::vector<std::string> labels;
   std::vector<std::string> skipped;   // sources that could not be read: the InputError text
   bool AllHaveTruth() const;          // non-empty and every cloud has a truth
 };
