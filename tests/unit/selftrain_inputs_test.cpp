@@ -39,6 +39,7 @@ UnlabelledClouds Instances(const std::vector<int>& sizes) {
     truth.t = Eigen::Vector3d(static_cast<double>(i), 0, 1);
     data.truth.push_back(truth);
     data.names.push_back("c" + std::to_string(i));
+    data.labels.push_back(i % 2 ? "a" : "");
   }
   return data;
 }
@@ -74,6 +75,7 @@ TEST_CASE("augmentation: copies drop the stated fraction, keep order, carry grou
     CHECK(copies.groups[k] == data.groups[i]);
     CHECK(copies.truth[k]->t == data.truth[i]->t);
     CHECK(copies.names[k] == data.names[i] + "#" + std::to_string(k % 3));
+    CHECK(copies.labels[k] == data.labels[i]);
   }
   // The copies of one instance drop different points.
   CHECK(copies.clouds[0] != copies.clouds[1]);
@@ -121,6 +123,9 @@ TEST_CASE("augmentation options are checked") {
   options = AugmentOptions{};
   options.noise_sigma = std::nan("");
   CHECK_THROWS_AS(Augment(Instances({10}), options), std::invalid_argument);
+  UnlabelledClouds short_labels = Instances({10, 10});
+  short_labels.labels.pop_back();
+  CHECK_THROWS_AS(Augment(short_labels, AugmentOptions{}), std::invalid_argument);
 }
 
 TEST_CASE("loading sources: one group per image, unreadable sources skipped with their reason") {
@@ -251,4 +256,75 @@ TEST_CASE("self-training splits by group: whole groups are trained on, at least 
   const std::vector<int> short_groups(3, 0);
   CHECK_THROWS_AS(SelfTrain(object, clouds, detector, options, {}, {}, false, nullptr, &short_groups),
                   std::invalid_argument);
+}
+
+TEST_CASE("mixed camera inputs: another object's augmented instances are never pseudo-labels") {
+  const ObjectModel object = test::AsymmetricObject(8000);
+  // Images with one instance of the object (obj_id 1) and one of a 12 cm cube
+  // (obj_id 2), as segment sources; the detector claims the object in both.
+  const Mesh cube = test::BoxMesh({0, 0, 0}, {0.12, 0.12, 0.12});
+  std::vector<CloudSource> sources;
+  Rng rng(8);
+  for (int image = 0; image < 8; ++image) {
+    for (int obj_id : {1, 2}) {
+      const Eigen::Vector3d t(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(1, 2));
+      const PointSet cloud =
+          (obj_id == 1 ? SampleSurface(object.mesh(), 300, 500 + image) : SampleSurface(cube, 300, 600 + image))
+              .colwise() + t;
+      CloudSource source;
+      source.name = std::to_string(image) + "_" + std::to_string(obj_id);
+      source.load_segment = [cloud]() {
+        SegmentCloud s;
+        s.cloud = cloud;
+        s.pixels.assign(static_cast<std::size_t>(cloud.cols()), 0);
+        s.mask_pixels = s.pixels.size();
+        return s;
+      };
+      CloudProvenance p;
+      p.scene_id = 1;
+      p.im_id = image;
+      p.gt_id = obj_id - 1;
+      p.obj_id = obj_id;
+      source.provenance = p;
+      sources.push_back(std::move(source));
+    }
+  }
+  UnlabelledClouds data = LoadUnlabelledClouds(sources);
+  REQUIRE(data.clouds.size() == 16);
+  CHECK(data.labels[0] == "obj_000001");
+  CHECK(data.labels[1] == "obj_000002");
+  AugmentOptions augment;
+  augment.copies = 3;
+  augment.noise_sigma = 0.0005;
+  augment.seed = 2;
+  data = Augment(data, augment);
+  REQUIRE(data.clouds.size() == 48);
+  SelfTrainOptions options;
+  options.epochs = 2;
+  options.batch = 8;
+  options.validation_fraction = 0.25;
+  options.stop_at_percent_oc = 101;
+  options.patience = 0;
+  options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
+  options.pipeline.certificate.eps_oc = 0.01;
+  RecordingOffsetDetector detector(object.keypoints().colwise() - Eigen::Vector3d(object.sample().rowwise().mean()));
+  const SelfTrainResult result = SelfTrain(object, data.clouds, detector, options, {}, {}, false, nullptr, &data.groups);
+  REQUIRE(result.pseudo_label_uses.size() == data.clouds.size());
+  int own_uses = 0, total_uses = 0;
+  for (std::size_t i = 0; i < data.clouds.size(); ++i) {
+    CAPTURE(data.names[i]);
+    if (data.labels[i] == "obj_000002") CHECK(result.pseudo_label_uses[i] == 0);
+    if (data.labels[i] == "obj_000001") own_uses += result.pseudo_label_uses[i];
+    total_uses += result.pseudo_label_uses[i];
+  }
+  CHECK(own_uses > 0);
+  // The uses count exactly the clouds the detector was trained on.
+  CHECK(total_uses == static_cast<int>(detector.trained.size()));
+  for (const PointSet& cloud : detector.trained) {
+    bool own = false;
+    for (std::size_t i = 0; i < data.clouds.size(); ++i) {
+      own = own || (data.labels[i] == "obj_000001" && data.clouds[i].cols() == cloud.cols() && data.clouds[i] == cloud);
+    }
+    CHECK(own);
+  }
 }

@@ -68,6 +68,11 @@ UnlabelledClouds LoadUnlabelledClouds(const std::vector<CloudSource>& sources) {
 
 UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions& options) {
   options.Check();
+  const std::size_t count = instances.clouds.size();
+  if (instances.groups.size() != count || instances.truth.size() != count || instances.names.size() != count ||
+      instances.labels.size() != count) {
+    throw std::invalid_argument("Augment: groups, truth, names and labels must have one entry per cloud");
+  }
   if (options.copies == 0) return instances;
   const std::size_t copies = static_cast<std::size_t>(options.copies);
   const std::size_t total = instances.clouds.size() * copies;

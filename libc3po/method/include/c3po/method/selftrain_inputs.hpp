@@ -50,6 +50,7 @@ UnlabelledClouds LoadUnlabelledClouds(const std::vector<CloudSource>& sources);
 // then instance 1's, ...), each keeping its instance's group, truth and name
 // (+ "#c"). A copy keeps n - round(drop_fraction * n) points (at least 1, in
 // their original order) and adds N(0, noise_sigma^2) to every coordinate.
+// std::invalid_argument when the per-cloud vectors differ in length.
 UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions& options);
 
 }  // namespace c3po
