@@ -105,7 +105,8 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
       data.groups.push_back(camera.groups[i] + offset);
       data.truth.push_back(camera.truth[i]);
       data.names.push_back(camera.names[i]);
-      data.labels.push_back(camera.labels[i]);
+      // --obj-id names this object's instances, whatever the object file calls it.
+      data.labels.push_back(camera.labels[i].empty() ? "" : object.name());
     }
   }
   return data;
