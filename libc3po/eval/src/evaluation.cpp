@@ -373,9 +373,7 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
     };
     results.push_back(EvaluateDetector(object, own_dataset, sources, detectors[d], options, per_detector));
   }
-  const bool mixed = !other_dataset.entries.empty() ||
-                     std::any_of(dataset.entries.begin(), dataset.entries.end(),
-                                 [](const DatasetEntry& e) { return e.object.has_value(); });
+  const bool mixed = !other_dataset.entries.empty();
   std::vector<ObjectAcceptance> objects;
   if (mixed) {
     std::map<std::string, std::vector<std::size_t>> other_by_label;

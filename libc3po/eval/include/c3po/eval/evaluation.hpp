@@ -143,8 +143,8 @@ struct Evaluation {
   double diameter = 0.0;
   EvaluationOptions options;           // absolute thresholds used
   std::vector<EvaluationRow> rows;
-  // Mixed datasets only (empty otherwise): this object first, then the
-  // other labels in name order, for each detector.
+  // Datasets with other objects' clouds only (empty otherwise): this object
+  // first, then the other labels in name order, for each detector.
   std::vector<ObjectAcceptance> objects;
   int total_false_certificates() const;
   int other_objects_accepted() const;  // certified clouds of other objects, all detectors
