@@ -47,9 +47,10 @@ struct SelftrainCommand {
 };
 
 // The unlabelled clouds: a dataset (as stored; augmented only with --copies
-// > 1) and/or camera inputs (always augmented: --copies copies per real
-// instance, each dropping --dropout of its points and adding --noise), each
-// with its validation group (a dataset cloud, or an image).
+// > 1) and/or camera inputs (--copies augmented copies per real instance,
+// each dropping --dropout of its points and adding --noise; 0 = the
+// instances as read), each with its validation group (a dataset cloud, or
+// an image).
 UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
   cmd.augment.noise_sigma = ParseThreshold(cmd.augment_noise, object.diameter(), "--noise");
   cmd.augment.seed = cmd.options.seed;
@@ -91,8 +92,7 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
     for (const std::string& skipped : camera.skipped) {
       std::fprintf(stderr, "c3po selftrain: skipped %s\n", skipped.c_str());
     }
-    AugmentOptions augment = cmd.augment;
-    augment.copies = std::max(1, augment.copies);
+    const AugmentOptions& augment = cmd.augment;
     const std::size_t instances = camera.clouds.size();
     camera = Augment(camera, augment);
     std::fprintf(stderr, "c3po selftrain: %zu real instances (%zu skipped) -> %zu augmented clouds (%d copies, "
@@ -276,7 +276,8 @@ RunFunction SetupSelftrain(CLI::App& command) {
   AddBopOptions(command, &cmd->bop, BopDetections::kRefused);
   AddSegmentOptions(command, &cmd->segment);
   command.add_option("--copies", cmd->augment.copies,
-                     "Augmented copies per real instance (camera inputs; with --data: per cloud when > 1)");
+                     "Augmented copies per real instance (camera inputs; 0 = the instances as read; with --data: per cloud when "
+                     "more than 1)");
   command.add_option("--dropout", cmd->augment.drop_fraction,
                      "Augmentation: fraction of each copy's points dropped");
   command.add_option("--noise", cmd->augment_noise,
