@@ -23,6 +23,7 @@ struct MergeCommand {
   std::vector<std::string> parts;
   std::string output_path;
   bool eval = false;   // --eval: eval --samples parts -> the table (+ -o: eval's --json document)
+  bool prefix_parts = false;
 };
 
 int RunEval(const MergeCommand& cmd) {
@@ -41,7 +42,7 @@ int Run(const MergeCommand& cmd) {
   if (cmd.output_path.empty()) throw InputError("c3po merge", "-o FILE is required (except with --eval)");
   std::error_code ec;
   if (std::filesystem::is_directory(cmd.parts.front(), ec)) {   // dataset folders (synth --shard)
-    const std::size_t clouds = MergeDatasets(cmd.parts, cmd.output_path);
+    const std::size_t clouds = MergeDatasets(cmd.parts, cmd.output_path, cmd.prefix_parts);
     std::printf("wrote %s: %zu clouds from %zu parts\n", cmd.output_path.c_str(), clouds, cmd.parts.size());
     return 0;
   }
@@ -68,11 +69,15 @@ RunFunction SetupMerge(CLI::App& command) {
                      "eval's --json document (optional)");
   command.add_flag("--eval", cmd->eval,
                    "Parts are eval --samples files of --shard 1/N .. N/N: print the unsharded eval table");
+  command.add_flag("--prefix-parts", cmd->prefix_parts,
+                   "Datasets: put each part's clouds under a folder named after the part (joins datasets with the "
+                   "same cloud names, e.g. several objects' clouds into a mixed dataset)");
   command.footer("Example:\n  parallel c3po certify obj.json --bop DIR --obj-id 5 --detector svd -o part{}.jsonl --bop-csv part{}.csv "
                  "--shard {}/4 ::: 1 2 3 4\n  c3po merge -o poses.jsonl part{1..4}.jsonl && c3po merge -o results.csv part{1..4}.csv\n"
                  "  c3po synth obj.json -o sim_{} --kind sim --count 1000 --shard {}/4 ...; c3po merge -o sim sim_1 sim_2 sim_3 sim_4\n"
                  "  parallel c3po eval obj.json --data sim --detector svd --samples s{}.jsonl --shard {}/4 ::: 1 2 3 4\n"
-                 "  c3po merge --eval s1.jsonl s2.jsonl s3.jsonl s4.jsonl -o eval.json");
+                 "  c3po merge --eval s1.jsonl s2.jsonl s3.jsonl s4.jsonl -o eval.json\n"
+                 "  c3po merge --prefix-parts -o mixed drill_depth mug_depth   # a mixed dataset (manifest \"object\" labels)");
   return [cmd]() { return Run(*cmd); };
 }
 

@@ -1,8 +1,11 @@
 // c3po selftrain: certificate-gated self-training of a trained detector on
 // unlabelled clouds (paper Section VI-C): only observably correct outputs
 // teach the detector, with their corrected keypoints as targets.
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
@@ -10,7 +13,9 @@
 #include "c3po/base/error.hpp"
 #include "c3po/io/dataset.hpp"
 #include "c3po/method/auto_threshold.hpp"
+#include "c3po/method/image_sources.hpp"
 #include "c3po/method/selftrain.hpp"
+#include "c3po/method/selftrain_inputs.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/pointnet.hpp"
 #include "command.hpp"
@@ -33,7 +38,79 @@ struct SelftrainCommand {
   CorrectorFlags corrector;
   RobustFlags robust;
   bool resume = false;
+  // Camera inputs (docs/camera_inputs.md) and the paper's augmentation.
+  FrameFlags frame;
+  BopFlags bop;
+  SegmentOptions segment;
+  AugmentOptions augment;
+  std::string augment_noise = "1mm";
 };
+
+// The unlabelled clouds: a dataset (as stored; augmented only with --copies
+// > 1) and/or camera inputs (--copies augmented copies per real instance,
+// each dropping --dropout of its points and adding --noise; 0 = the
+// instances as read), each with its validation group (a dataset cloud, or
+// an image).
+UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
+  cmd.augment.noise_sigma = ParseThreshold(cmd.augment_noise, object.diameter(), "--noise");
+  cmd.augment.seed = cmd.options.seed;
+  try {
+    cmd.augment.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("c3po selftrain", e.what());
+  }
+  CheckSegmentOptions(cmd.segment, "c3po selftrain");
+  UnlabelledClouds data;
+  if (!cmd.data_dir.empty()) {
+    const Dataset dataset = ReadDataset(cmd.data_dir);
+    data.clouds = LoadDatasetClouds(dataset, "loading");
+    for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
+      data.groups.push_back(static_cast<int>(i));
+      data.truth.push_back(dataset.entries[i].pose);
+      data.names.push_back(dataset.entries[i].cloud);
+      data.labels.push_back(dataset.entries[i].object.value_or(""));
+    }
+    if (cmd.augment.copies > 1) data = Augment(data, cmd.augment);
+  }
+  std::vector<CloudSource> sources;
+  if (cmd.frame.given()) {
+    for (auto& s : FrameSources(ResolveFrame(cmd.frame, "c3po selftrain"), cmd.segment)) sources.push_back(s);
+  }
+  if (!cmd.bop.dir.empty()) {
+    const BopInstances listed = ListBopInstances(cmd.bop.dir, cmd.bop.options);
+    if (listed.instances.empty()) {
+      throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id) +
+                                        (cmd.bop.options.targets_path.empty() ? "" : " among the targets"));
+    }
+    for (auto& s : BopSources(listed, cmd.segment)) sources.push_back(s);
+  }
+  if (cmd.data_dir.empty() && sources.empty()) {
+    throw InputError("c3po selftrain", "no clouds given (--data DIR, --depth/--mask or --bop DIR)");
+  }
+  if (!sources.empty()) {
+    UnlabelledClouds camera = LoadUnlabelledClouds(sources);
+    for (const std::string& skipped : camera.skipped) {
+      std::fprintf(stderr, "c3po selftrain: skipped %s\n", skipped.c_str());
+    }
+    const AugmentOptions& augment = cmd.augment;
+    const std::size_t instances = camera.clouds.size();
+    camera = Augment(camera, augment);
+    std::fprintf(stderr, "c3po selftrain: %zu real instances (%zu skipped) -> %zu augmented clouds (%d copies, "
+                 "dropout %.3g, noise %.4g)\n", instances, camera.skipped.size(), camera.clouds.size(),
+                 augment.copies, augment.drop_fraction, augment.noise_sigma);
+    // Camera groups come after the dataset's: no two inputs share a group.
+    const int offset = data.groups.empty() ? 0 : *std::max_element(data.groups.begin(), data.groups.end()) + 1;
+    for (std::size_t i = 0; i < camera.clouds.size(); ++i) {
+      data.clouds.push_back(std::move(camera.clouds[i]));
+      data.groups.push_back(camera.groups[i] + offset);
+      data.truth.push_back(camera.truth[i]);
+      data.names.push_back(camera.names[i]);
+      // --obj-id names this object's instances, whatever the object file calls it.
+      data.labels.push_back(camera.labels[i].empty() ? "" : object.name());
+    }
+  }
+  return data;
+}
 
 nlohmann::json EpochJson(const SelfTrainEpochLog& e) {
   nlohmann::json j = nlohmann::json::parse(ToJson(e));
@@ -69,15 +146,18 @@ int Run(SelftrainCommand cmd) {
   if (cmd.resume && !std::filesystem::exists(options.checkpoint_path)) {
     throw InputError(options.checkpoint_path, "no checkpoint to resume from");
   }
-  const Dataset dataset = ReadDataset(cmd.data_dir);
-  if (dataset.entries.size() < 2) throw InputError(cmd.data_dir, "need at least 2 clouds to self-train");
-  const std::vector<PointSet> clouds = LoadDatasetClouds(dataset, "loading");
-  // Ground truth, when the dataset has it, only feeds the log's reporting
+  const UnlabelledClouds data = LoadClouds(cmd, object);
+  const std::vector<PointSet>& clouds = data.clouds;
+  if (clouds.size() < 2) throw InputError("c3po selftrain", "need at least 2 clouds to self-train");
+  // Ground truth, when every cloud has it, only feeds the log's reporting
   // columns (rotation error, Hausdorff distance); selection never reads it.
   std::optional<SelfTrainReference> reference;
-  if (dataset.HasGroundTruth()) {
+  // Another object's truth is not this object's: no reporting columns on a mixed set.
+  const bool mixed = std::any_of(data.labels.begin(), data.labels.end(),
+                                 [&](const std::string& label) { return !label.empty() && label != object.name(); });
+  if (data.AllHaveTruth() && !mixed) {
     reference.emplace();
-    for (const auto& entry : dataset.entries) reference->scene_from_model.push_back(*entry.pose);
+    for (const auto& truth : data.truth) reference->scene_from_model.push_back(*truth);
   }
   std::string eps_oc_evidence;
   if (cmd.thresholds.auto_eps_oc()) {
@@ -120,7 +200,7 @@ int Run(SelftrainCommand cmd) {
         progress = ProgressBar("selftrain", 1);
       },
       [&](std::size_t done, std::size_t total) { progress.Update(total ? done / total : 0); }, cmd.resume,
-      reference ? &*reference : nullptr);
+      reference ? &*reference : nullptr, &data.groups);
   progress.Finish();
   nlohmann::json extra = {
       {"selftrained", true},
@@ -136,6 +216,23 @@ int Run(SelftrainCommand cmd) {
                      {"best_validation_residual_q50", result.best.residual_q50},
                      {"stopped_early", result.stopped_early}}}};
   if (!eps_oc_evidence.empty()) extra["selftrain"]["eps_oc_auto"] = nlohmann::json::parse(eps_oc_evidence);
+  if (mixed) {
+    // Per object label: clouds, clouds whose pseudo-label was trained on, training uses.
+    std::map<std::string, std::array<long, 3>> by_label;
+    for (std::size_t i = 0; i < clouds.size(); ++i) {
+      auto& counts = by_label[data.labels[i].empty() ? "(unlabelled)" : data.labels[i]];
+      counts[0] += 1;
+      counts[1] += result.pseudo_label_uses[i] > 0;
+      counts[2] += result.pseudo_label_uses[i];
+    }
+    nlohmann::json table = nlohmann::json::object();
+    for (const auto& [label, counts] : by_label) {
+      table[label] = {{"clouds", counts[0]}, {"trained_on", counts[1]}, {"uses", counts[2]}};
+      std::printf("pseudo-labels from %s clouds%s: %ld of %ld clouds trained on (%ld uses)\n", label.c_str(),
+                  label == object.name() ? " (this object)" : "", counts[1], counts[0], counts[2]);
+    }
+    extra["selftrain"]["pseudo_labels_by_object"] = table;
+  }
   detector->Save(cmd.output_path, extra.dump());
   std::printf("wrote %s: validation %% oc %.1f -> %.1f, %% identified %.1f -> %.1f, residual q50 %.3g -> %.3g "
               "(best epoch %d%s); eps_oc = %.6g; log %s\n",
@@ -154,7 +251,7 @@ RunFunction SetupSelftrain(CLI::App& command) {
   SelfTrainOptions& o = cmd->options;
   command.add_option("object", cmd->object_path, "Object JSON")->required();
   command.add_option("--model", cmd->model_path, "Trained model (e.g. from c3po train on sim data)")->required();
-  command.add_option("--data", cmd->data_dir, "Unlabelled dataset (ground truth, if any, is ignored)")->required();
+  command.add_option("--data", cmd->data_dir, "Unlabelled dataset (ground truth, if any, is only reported)");
   command.add_option("-o,--output", cmd->output_path, "Self-trained model file to write")->required();
   command.add_option("--epochs", o.epochs, "Maximum epochs");
   command.add_option("--batch", o.batch, "Batch size");
@@ -175,6 +272,16 @@ RunFunction SetupSelftrain(CLI::App& command) {
   AddRobustOptions(command, &cmd->robust);
   AddSeedOption(command, &o.seed, "split, shuffling");
   command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt");
+  AddFrameOptions(command, &cmd->frame);
+  AddBopOptions(command, &cmd->bop, BopDetections::kRefused);
+  AddSegmentOptions(command, &cmd->segment);
+  command.add_option("--copies", cmd->augment.copies,
+                     "Augmented copies per real instance (camera inputs; 0 = the instances as read; with --data: per cloud when "
+                     "more than 1)");
+  command.add_option("--dropout", cmd->augment.drop_fraction,
+                     "Augmentation: fraction of each copy's points dropped");
+  command.add_option("--noise", cmd->augment_noise,
+                     "Augmentation: Gaussian noise sigma per coordinate (a distance: 1mm, 0.001, 0.5%d)");
   return [cmd]() { return Run(*cmd); };
 }
 

@@ -138,6 +138,8 @@ mkdir -p no_manifest && cp sim/000000.ply no_manifest/
 check dataset_no_manifest "2" - no_manifest no_manifest -- "$C3PO" certify "$CUBE" --detector svd --data no_manifest
 mkdir -p bad_manifest && cp sim/000000.ply bad_manifest/ && printf '{"cloud":"000000.ply"}\n{"cloud":\n' > bad_manifest/manifest.jsonl
 check dataset_bad_manifest_line "2" - manifest.jsonl bad_manifest -- "$C3PO" certify "$CUBE" --detector svd --data bad_manifest
+mkdir -p bad_label && cp sim/000000.ply bad_label/ && printf '{"cloud":"000000.ply","object":["drill"]}\n' > bad_label/manifest.jsonl
+check dataset_bad_object_label "2" - object bad_label -- "$C3PO" certify "$CUBE" --detector svd --data bad_label
 
 # --- model files ------------------------------------------------------------
 # (Need a trained pointnet model: skipped in a C3PO_WITH_POINTNET=OFF build.)
@@ -258,6 +260,10 @@ if [ "${C3PO_WITH_POINTNET:-ON}" != OFF ] && [ -e cube.model ]; then
   check selftrain_ambiguity_ratio "2" st.model "c3po selftrain" sim cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --data sim -o st.model --ambiguity-ratio 0.5
   check selftrain_residual_tol "2" st.model "c3po selftrain" sim cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --data sim -o st.model --residual-tolerance nan
   check selftrain_patience "2" st.model "c3po selftrain" sim cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --data sim -o st.model --patience -1
+  # camera inputs (issue 18 part 3): the same one-line errors as certify's, no model written
+  check selftrain_bop_missing_mask "2" st.model scene_gt.json split_missing_mask cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --bop split_missing_mask --obj-id 1 -o st.model
+  check selftrain_depth_mask_sizes "2" st.model mask_small.png depth.png mask_small.png cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --depth depth.png --mask mask_small.png --camera camera.json -o st.model
+  check selftrain_copies "2" st.model "copies" split_ok cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --bop split_ok --obj-id 1 --copies 5000 -o st.model
 fi
 
 echo "failures: $failures"

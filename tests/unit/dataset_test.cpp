@@ -60,6 +60,7 @@ void CheckSame(const c3po::DatasetEntry& a, const c3po::DatasetEntry& b) {
   CHECK(a.detected_keypoints.has_value() == b.detected_keypoints.has_value());
   if (a.detected_keypoints && b.detected_keypoints) CHECK(*a.detected_keypoints == *b.detected_keypoints);
   CHECK(a.visible == b.visible);
+  CHECK(a.object == b.object);
 }
 
 std::vector<std::string> Listing(const std::string& folder) {
@@ -331,4 +332,81 @@ TEST_CASE("float32 / few-digit rotations (within 1e-4) are projected; certify-st
   CHECK(!skipped.pose);
   CHECK(!skipped.keypoints);
   CHECK(skipped.cloud == "a.ply");
+}
+
+TEST_CASE("object labels: round trip, validation, keypoint counts agree per object only") {
+  c3po::Rng rng(21);
+  c3po::DatasetEntry entry = RandomEntry(rng, "a.ply", 4);
+  entry.object = "035 power drill (YCB)";
+  const std::string line = c3po::ManifestLine(entry);
+  CHECK(line.find("\"object\":\"035 power drill (YCB)\"") != std::string::npos);
+  CheckSame(c3po::ParseManifestLine(line, "m"), entry);
+  CHECK(ParseError("{\"cloud\":\"a.ply\",\"object\":5}") ==
+        "m.jsonl: line 4: object: expected a string (the object's name)");
+  CHECK(ParseError("{\"cloud\":\"a.ply\",\"object\":\"\"}") == "m.jsonl: line 4: object: expected 1 to 256 characters");
+  CHECK(ParseError("{\"cloud\":\"a.ply\",\"object\":\"" + std::string(257, 'x') + "\"}") ==
+        "m.jsonl: line 4: object: expected 1 to 256 characters");
+  CHECK(ParseError("{\"cloud\":\"a.ply\",\"object\":\"a\\nb\"}") == "m.jsonl: line 4: object: control character in 'a?b'");
+  entry.object = "";
+  CHECK_THROWS_AS(c3po::ManifestLine(entry), std::invalid_argument);
+  entry.object = std::string("a\tb");
+  CHECK_THROWS_AS(c3po::ManifestLine(entry), std::invalid_argument);
+
+  // Different objects may have different keypoint counts; the same object may not.
+  c3po::test::TempDir dir("dataset_labels");
+  c3po::WritePly(dir / "a.ply", RandomPoints(rng, 10));
+  c3po::WritePly(dir / "b.ply", RandomPoints(rng, 12));
+  c3po::WritePly(dir / "c.ply", RandomPoints(rng, 12));
+  c3po::DatasetEntry a = RandomEntry(rng, "a.ply", 4), b = RandomEntry(rng, "b.ply", 5), c = RandomEntry(rng, "c.ply", 6);
+  a.object = "drill";
+  b.object = "mug";
+  c.object = "drill";
+  const std::string manifest = dir / "manifest.jsonl";
+  c3po::WriteFileAtomically(manifest, c3po::ManifestLine(a) + "\n" + c3po::ManifestLine(b) + "\n");
+  const c3po::Dataset mixed = c3po::ReadDataset(dir.path());
+  REQUIRE(mixed.entries.size() == 2);
+  CHECK(mixed.Shows(0, "drill"));
+  CHECK_FALSE(mixed.Shows(1, "drill"));
+  CHECK(mixed.Shows(1, "mug"));
+  c3po::WriteFileAtomically(manifest, c3po::ManifestLine(a) + "\n" + c3po::ManifestLine(b) + "\n" +
+                                          c3po::ManifestLine(c) + "\n");
+  CHECK(InputErrorOf([&] { c3po::ReadDataset(dir.path()); }) ==
+        manifest + ": line 3: keypoints: 6 keypoints, but line 1 has 4 (object drill)");
+  // An unlabelled line shows every object.
+  c3po::DatasetEntry bare;
+  bare.cloud = "a.ply";
+  c3po::WriteFileAtomically(manifest, c3po::ManifestLine(bare) + "\n");
+  CHECK(c3po::ReadDataset(dir.path()).Shows(0, "anything"));
+}
+
+TEST_CASE("MergeDatasets --prefix-parts joins datasets with the same cloud names, labels kept") {
+  c3po::test::TempDir dir("dataset_merge_prefix");
+  c3po::Rng rng(22);
+  std::vector<c3po::PointSet> clouds;
+  for (const std::string part : {"drill", "mug"}) {
+    c3po::DatasetWriter writer(dir / part);
+    for (int i = 0; i < 3; ++i) {
+      c3po::DatasetEntry entry = RandomEntry(rng, "00000" + std::to_string(i) + ".ply", part == "drill" ? 4 : 7);
+      entry.object = part;
+      clouds.push_back(RandomPoints(rng, 5 + i));
+      writer.Add(static_cast<std::size_t>(i), entry, clouds.back());
+    }
+    writer.Commit();
+  }
+  // Without the prefix the names collide.
+  CHECK(InputErrorOf([&] { c3po::MergeDatasets({dir / "drill", dir / "mug"}, dir / "plain"); }).find(
+            "is also in an earlier part") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "plain"));
+  CHECK(c3po::MergeDatasets({dir / "drill", dir / "mug/"}, dir / "mixed", true) == 6);
+  const c3po::Dataset mixed = c3po::ReadDataset(dir / "mixed");
+  REQUIRE(mixed.entries.size() == 6);
+  for (std::size_t i = 0; i < 6; ++i) {
+    const std::string part = i < 3 ? "drill" : "mug";
+    CHECK(mixed.entries[i].cloud == part + "/00000" + std::to_string(i % 3) + ".ply");
+    CHECK(mixed.entries[i].object == part);
+    CHECK(mixed.LoadCloud(i).isApprox(clouds[i], 1e-6));
+  }
+  // Two parts with the same folder name still collide.
+  CHECK(InputErrorOf([&] { c3po::MergeDatasets({dir / "drill", dir / "drill"}, dir / "twice", true); }).find(
+            "two parts with the same folder name") != std::string::npos);
 }

@@ -348,3 +348,82 @@ TEST_CASE("a dataset without ground truth or without detected keypoints is an in
   bad.adds_threshold = 0.0;
   CHECK_THROWS_AS(Evaluate(object, ReadDataset(dir / "nodet"), {{"m", nullptr, false}}, bad), std::invalid_argument);
 }
+
+TEST_CASE("mixed dataset: rows from the object's clouds only, other objects' clouds counted and rejected") {
+  Fixture f;
+  // The fixture's clouds (labelled with the object's name, or not) interleaved
+  // with a 12 cm cube's clouds whose detections claim the object is there
+  // (its keypoints posed at the cube's centre): no pose of the asymmetric
+  // object explains a cube within eps_oc, so none may be accepted. A third
+  // label's detections have the wrong keypoint count: failures, not accepted.
+  const Mesh cube = BoxMesh({0, 0, 0}, {0.12, 0.12, 0.12});
+  DatasetWriter writer(f.dir / "mixed");
+  std::vector<std::size_t> own_entries;
+  std::size_t order = 0;
+  Rng rng(77);
+  for (int i = 0; i < kClouds; ++i) {
+    DatasetEntry own = f.dataset.entries[static_cast<std::size_t>(i)];
+    if (i % 2 == 0) own.object = f.object.name();
+    own_entries.push_back(order);
+    writer.Add(order++, own, f.dataset.LoadCloud(static_cast<std::size_t>(i)));
+    Pose pose;
+    pose.R = rng.Rotation();
+    pose.t = Eigen::Vector3d(rng.Uniform(), rng.Uniform(), 1.0 + rng.Uniform());
+    DatasetEntry other;
+    other.cloud = "cube_" + std::to_string(i) + ".ply";
+    other.object = i % 3 == 0 ? "cube5" : "cube";
+    other.pose = pose;
+    other.detected_keypoints = i % 3 == 0 ? PointSet(pose * PointSet(cube.vertices.leftCols(5)))
+                                          : PointSet(pose * PointSet(f.object.keypoints().colwise() -
+                                                                     Eigen::Vector3d(f.object.sample().rowwise().mean())));
+    writer.Add(order++, other, pose * SampleSurface(cube, 400, 100 + i));
+  }
+  writer.Commit();
+  const Dataset mixed = ReadDataset(f.dir / "mixed");
+  EvaluationOptions options = EvaluationOptions::Defaults(f.object);
+  const Evaluation alone = Evaluate(f.object, f.dataset, {{"manifest", nullptr, false}}, options);
+  const Evaluation e = Evaluate(f.object, mixed, {{"manifest", nullptr, false}}, options);
+  CHECK(e.clouds == kClouds);
+  REQUIRE(e.rows.size() == alone.rows.size());
+  for (std::size_t r = 0; r < e.rows.size(); ++r) {
+    REQUIRE(e.rows[r].samples.size() == alone.rows[r].samples.size());
+    CHECK(e.rows[r].summary.certified == alone.rows[r].summary.certified);
+    for (std::size_t k = 0; k < e.rows[r].samples.size(); ++k) {
+      const SampleResult& s = e.rows[r].samples[k];
+      // Indices name the mixed dataset's entries.
+      CHECK(s.index == own_entries[alone.rows[r].samples[k].index]);
+      CHECK(mixed.entries[s.index].cloud == s.cloud);
+      CHECK(s.ok() == alone.rows[r].samples[k].ok());
+      if (s.ok()) CHECK((s.scene_from_model.R - alone.rows[r].samples[k].scene_from_model.R).norm() < 1e-9);
+    }
+  }
+  REQUIRE(e.objects.size() == 3);
+  CHECK(e.objects[0].evaluated_object);
+  CHECK(e.objects[0].object == f.object.name());
+  CHECK(e.objects[0].clouds == kClouds);
+  CHECK(e.objects[0].certified == alone.rows.back().summary.certified);   // the corrector row
+  CHECK(e.objects[0].certified > 0);
+  CHECK(e.objects[1].object == "cube");
+  CHECK(e.objects[1].clouds == kClouds - 4);
+  CHECK(e.objects[1].failures == 0);
+  CHECK(e.objects[1].certified == 0);
+  CHECK(e.objects[2].object == "cube5");
+  CHECK(e.objects[2].clouds == 4);
+  CHECK(e.objects[2].failures == 4);
+  CHECK(e.objects[2].certified == 0);
+  CHECK(e.other_objects_accepted() == 0);
+  CHECK(EvaluationTable(e).find("cube 0 of 8 accepted") != std::string::npos);
+  CHECK(EvaluationJson(e).find("\"other_objects_accepted\": 0") != std::string::npos);
+  // A single-object dataset has no per-object lines.
+  CHECK(alone.objects.empty());
+  CHECK(EvaluationTable(alone).find("Mixed dataset") == std::string::npos);
+
+  // No cloud of the object at all: an input error naming the manifest.
+  Dataset cubes;
+  cubes.dir = mixed.dir;
+  for (const DatasetEntry& entry : mixed.entries) {
+    if (entry.object == "cube") cubes.entries.push_back(entry);
+  }
+  CHECK_THROWS_WITH_AS(Evaluate(f.object, cubes, {{"manifest", nullptr, false}}, options),
+                       doctest::Contains("no cloud of object"), InputError);
+}

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "c3po/base/error.hpp"
@@ -273,6 +274,12 @@ int Evaluation::total_false_certificates_hausdorff() const {
   return total;
 }
 
+int Evaluation::other_objects_accepted() const {
+  int accepted = 0;
+  for (const ObjectAcceptance& a : objects) accepted += a.evaluated_object ? 0 : a.certified;
+  return accepted;
+}
+
 const EvaluationRow* Evaluation::MainRow() const {
   for (const auto& row : rows) {
     if (row.method == EvalMethod::kC3po && row.subset == EvalSubset::kAll) return &row;
@@ -350,16 +357,75 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
                     const EvaluationOptions& options, const ProgressCallback& progress) {
   options.Check();
   if (detectors.empty()) throw std::invalid_argument("Evaluate: no detectors");
-  CheckDataset(dataset, detectors);
-  const std::size_t count = dataset.entries.size();
-  const std::vector<CloudSource> sources = DatasetSources(dataset);
+  // Mixed datasets: the object's own clouds make the rows, the others are
+  // only certified and counted (per label).
+  Dataset own_dataset, other_dataset;
+  own_dataset.dir = other_dataset.dir = dataset.dir;
+  std::vector<std::size_t> own_index;
+  for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
+    if (dataset.Shows(i, object.name())) {
+      own_dataset.entries.push_back(dataset.entries[i]);
+      own_index.push_back(i);
+    } else {
+      other_dataset.entries.push_back(dataset.entries[i]);
+    }
+  }
+  if (own_dataset.entries.empty() && !dataset.entries.empty()) {
+    throw InputError(dataset.dir + "/manifest.jsonl",
+                     "no cloud of object '" + object.name() + "' (every line's \"object\" names another)");
+  }
+  CheckDataset(own_dataset, detectors);
+  const std::size_t count = own_dataset.entries.size();
+  const std::vector<CloudSource> sources = DatasetSources(own_dataset);
   std::vector<DetectorResults> results;
   for (std::size_t d = 0; d < detectors.size(); ++d) {
     // Progress over all detectors' clouds, reported as clouds of the dataset.
     const ProgressCallback per_detector = [&, d](std::size_t done, std::size_t) {
       if (progress) progress((d * count + done) / detectors.size(), count);
     };
-    results.push_back(EvaluateDetector(object, dataset, sources, detectors[d], options, per_detector));
+    results.push_back(EvaluateDetector(object, own_dataset, sources, detectors[d], options, per_detector));
+  }
+  const bool mixed = !other_dataset.entries.empty();
+  std::vector<ObjectAcceptance> objects;
+  if (mixed) {
+    std::map<std::string, std::vector<std::size_t>> other_by_label;
+    for (std::size_t i = 0; i < other_dataset.entries.size(); ++i) {
+      other_by_label[*other_dataset.entries[i].object].push_back(i);
+    }
+    const std::vector<CloudSource> other_sources = DatasetSources(other_dataset);
+    CertifyBatchOptions batch;
+    batch.pipeline = options.pipeline;
+    batch.pipeline.correct = true;
+    for (std::size_t d = 0; d < detectors.size(); ++d) {
+      ObjectAcceptance own;
+      own.detector = detectors[d].label;
+      own.object = object.name();
+      own.evaluated_object = true;
+      for (const SampleResult& sample : results[d][kCorrected]) {
+        ++own.clouds;
+        own.failures += !sample.ok();
+        own.observably_correct += sample.oc;
+        own.certified += sample.certified();
+      }
+      objects.push_back(own);
+      if (other_sources.empty()) continue;
+      // A detector's failure on a cloud (e.g. the manifest's detected
+      // keypoints are another object's count) rejects that cloud.
+      const CertifyBatchResult other = CertifyBatch(object, other_sources, detectors[d].detector, batch);
+      for (const auto& [label, members] : other_by_label) {
+        ObjectAcceptance a;
+        a.detector = detectors[d].label;
+        a.object = label;
+        for (std::size_t i : members) {
+          const CloudOutcome& outcome = other.outcomes[i];
+          ++a.clouds;
+          a.failures += !outcome.processed();
+          a.observably_correct += outcome.processed() && outcome.estimate.ok() && outcome.estimate.certificate.oc.passed;
+          a.certified += outcome.certified();
+        }
+        objects.push_back(a);
+      }
+    }
   }
 
   Evaluation evaluation;
@@ -371,6 +437,12 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
   for (std::size_t d = 0; d < detectors.size(); ++d) {
     AppendRows(detectors[d], std::move(results[d]), options, object.diameter(), &evaluation.rows);
   }
+  // Sample indices name the dataset's entries, also when others were set aside.
+  for (EvaluationRow& row : evaluation.rows) {
+    for (SampleResult& sample : row.samples) sample.index = own_index[sample.index];
+    for (FalseCertificate& f : row.summary.worst_false_certificates) f.index = own_index[f.index];
+  }
+  evaluation.objects = std::move(objects);
   return evaluation;
 }
 

@@ -165,6 +165,28 @@ json SummaryJson(const RowSummary& s, double diameter) {
   return j;
 }
 
+
+// Mixed datasets: per detector and object label, the clouds accepted by
+// detector + corrector + certificates.
+std::string ObjectLines(const Evaluation& e) {
+  if (e.objects.empty()) return "";
+  std::ostringstream out;
+  out << "Mixed dataset: clouds accepted (certified) by detector + corrector + certificates of " << e.object_name
+      << ", per object:\n";
+  for (const ObjectAcceptance& a : e.objects) {
+    out << "  " << a.detector << ": " << a.object << (a.evaluated_object ? " (this object)" : "") << " "
+        << a.certified << " of " << a.clouds << " accepted (oc " << a.observably_correct;
+    if (a.failures > 0) out << ", " << a.failures << " without a pose";
+    out << ")";
+    if (!a.evaluated_object && a.clouds > 0) {
+      out << ", rejected " << Format("%.1f", 100.0 * (a.clouds - a.certified) / a.clouds) << " %";
+    }
+    out << "\n";
+  }
+  out << "Other objects' clouds accepted: " << e.other_objects_accepted() << "\n";
+  return out.str();
+}
+
 }  // namespace
 
 std::string EvaluationTable(const Evaluation& e) {
@@ -189,7 +211,7 @@ std::string EvaluationTable(const Evaluation& e) {
       out << std::string(total - 2, '-') << "\n";
     }
   }
-  out << SettingsLines(e) << FailureLines(e) << SoundnessLines(e);
+  out << SettingsLines(e) << FailureLines(e) << SoundnessLines(e) << ObjectLines(e);
   return out.str();
 }
 
@@ -233,6 +255,16 @@ std::string EvaluationJson(const Evaluation& e) {
     rows.push_back(r);
   }
   j["rows"] = rows;
+  if (!e.objects.empty()) {
+    json objects = json::array();
+    for (const ObjectAcceptance& a : e.objects) {
+      objects.push_back({{"detector", a.detector}, {"object", a.object}, {"evaluated_object", a.evaluated_object},
+                         {"clouds", a.clouds}, {"failures", a.failures},
+                         {"observably_correct", a.observably_correct}, {"certified", a.certified}});
+    }
+    j["objects"] = objects;
+    j["other_objects_accepted"] = e.other_objects_accepted();
+  }
   return j.dump(1) + "\n";
 }
 

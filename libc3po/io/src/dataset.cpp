@@ -5,6 +5,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -25,6 +26,8 @@ namespace {
 constexpr int kMaxJsonDepth = 16;
 
 // `text` with control characters replaced, so messages stay on one line.
+constexpr std::size_t kMaxObjectLabel = 256;
+
 std::string Printable(const std::string& text) {
   std::string printable = text.substr(0, 200);
   for (char& c : printable) {
@@ -139,6 +142,20 @@ class LineParser {
     return points;
   }
 
+  std::optional<std::string> ObjectLabel() const {
+    const nlohmann::json* value = Find("object");
+    if (!value) return std::nullopt;
+    if (!value->is_string()) Fail("object", "expected a string (the object's name)");
+    const std::string label = value->get<std::string>();
+    if (label.empty() || label.size() > kMaxObjectLabel) {
+      Fail("object", "expected 1 to " + std::to_string(kMaxObjectLabel) + " characters");
+    }
+    for (unsigned char c : label) {
+      if (c < 0x20 || c == 0x7f) Fail("object", "control character in '" + Printable(label) + "'");
+    }
+    return label;
+  }
+
   std::optional<std::vector<bool>> Visible() const {
     const nlohmann::json* value = Find("visible");
     if (!value) return std::nullopt;
@@ -186,6 +203,11 @@ std::string Dataset::CloudPath(std::size_t i) const { return dir + "/" + entries
 
 PointSet Dataset::LoadCloud(std::size_t i) const { return ReadCloud(CloudPath(i)); }
 
+bool Dataset::Shows(std::size_t i, const std::string& object_name) const {
+  const DatasetEntry& entry = entries.at(i);
+  return !entry.object || *entry.object == object_name;
+}
+
 bool Dataset::HasGroundTruth() const {
   return !entries.empty() && std::all_of(entries.begin(), entries.end(), [](const DatasetEntry& e) {
            return e.pose.has_value() && e.keypoints.has_value();
@@ -216,6 +238,7 @@ DatasetEntry ParseManifestLine(const std::string& line, const std::string& where
     entry.visible = parser.Visible();
   }
   entry.detected_keypoints = parser.Points("detected_keypoints");
+  entry.object = parser.ObjectLabel();
   KeypointCount(entry, where);
   return entry;
 }
@@ -238,6 +261,15 @@ std::string ManifestLine(const DatasetEntry& entry) {
     for (bool v : *entry.visible) flags.push_back(v);
     line["visible"] = flags;
   }
+  if (entry.object) {
+    const bool printable = std::none_of(entry.object->begin(), entry.object->end(), [](char c) {
+      return static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+    });
+    if (entry.object->empty() || entry.object->size() > kMaxObjectLabel || !printable) {
+      throw std::invalid_argument("ManifestLine: object label must be 1-256 printable characters");
+    }
+    line["object"] = *entry.object;
+  }
   return line.dump();
 }
 
@@ -253,7 +285,8 @@ Dataset ReadDataset(const std::string& dir_argument, bool ground_truth) {
 
   Dataset dataset;
   dataset.dir = dir;
-  std::size_t keypoints = 0, keypoints_line = 0;
+  // The keypoint count of each object label ("" = unlabelled lines) and the line that set it.
+  std::map<std::string, std::pair<std::size_t, std::size_t>> keypoint_counts;
   std::size_t line_number = 0, start = 0;
   while (start < text.size()) {
     std::size_t end = text.find('\n', start);
@@ -266,9 +299,11 @@ Dataset ReadDataset(const std::string& dir_argument, bool ground_truth) {
     const std::string where = manifest + ": line " + std::to_string(line_number);
     DatasetEntry entry = ParseManifestLine(line, where, ground_truth);
     const auto [count, field] = KeypointCount(entry, where);
+    auto& [keypoints, keypoints_line] = keypoint_counts[entry.object.value_or("")];
     if (count > 0 && keypoints > 0 && count != keypoints) {
       throw InputError(where + ": " + field + ": " + std::to_string(count) + " keypoints, but line " +
-                       std::to_string(keypoints_line) + " has " + std::to_string(keypoints));
+                       std::to_string(keypoints_line) + " has " + std::to_string(keypoints) +
+                       (entry.object ? " (object " + Printable(*entry.object) + ")" : std::string()));
     }
     if (count > 0 && keypoints == 0) {
       keypoints = count;

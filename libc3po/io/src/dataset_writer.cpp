@@ -59,17 +59,21 @@ void DatasetWriter::Commit() {
   committed_ = true;
 }
 
-std::size_t MergeDatasets(const std::vector<std::string>& parts, const std::string& dir) {
+std::size_t MergeDatasets(const std::vector<std::string>& parts, const std::string& dir, bool prefix_parts) {
   DatasetWriter writer(dir);
   std::set<std::string> names;
   std::size_t order = 0;
   for (const std::string& part : parts) {
     const Dataset dataset = ReadDataset(part);
+    const std::string prefix = prefix_parts ? fs::path(dataset.dir).filename().string() + "/" : std::string();
     for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
-      if (!names.insert(dataset.entries[i].cloud).second) {
-        throw InputError(part, "cloud " + dataset.entries[i].cloud + " is also in an earlier part");
+      DatasetEntry entry = dataset.entries[i];
+      entry.cloud = prefix + entry.cloud;
+      if (!names.insert(entry.cloud).second) {
+        throw InputError(part, "cloud " + entry.cloud + " is also in an earlier part" +
+                                   (prefix_parts ? " (two parts with the same folder name)" : ""));
       }
-      writer.Add(order++, dataset.entries[i], dataset.LoadCloud(i));
+      writer.Add(order++, entry, dataset.LoadCloud(i));
     }
   }
   writer.Commit();

@@ -106,6 +106,19 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
   return sources;
 }
 
+PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts) {
+  if (!source.load_segment) return source.load();
+  SegmentCloud segment = source.load_segment();
+  PointSet cloud = std::move(segment.cloud);
+  segment.cloud.resize(3, 0);   // the counts stay for the output
+  if (segment_counts != nullptr) *segment_counts = segment;
+  if (cloud.cols() < kMinSegmentPoints) {
+    segment.cloud = cloud;
+    RequireUsableSegment(segment, source.name);   // throws the reason
+  }
+  return cloud;
+}
+
 void CertifyBatchOptions::Check() const {
   pipeline.Check();
   if (auto_eps_oc) auto_eps_oc_options.Check();
@@ -137,19 +150,7 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
     const auto start = std::chrono::steady_clock::now();
     PointSet cloud;
     try {
-      if (source.load_segment) {
-        SegmentCloud segment = source.load_segment();
-        cloud = std::move(segment.cloud);
-        segment.cloud.resize(3, 0);   // the counts stay for the output
-        outcome.segment = std::move(segment);
-        if (cloud.cols() < kMinSegmentPoints) {
-          SegmentCloud counts = *outcome.segment;
-          counts.cloud = cloud;
-          RequireUsableSegment(counts, source.name);   // throws the reason
-        }
-      } else {
-        cloud = source.load();
-      }
+      cloud = LoadSourceCloud(source, &outcome.segment);
     } catch (const Interrupted&) {
       throw;
     } catch (const std::exception& e) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <stdexcept>
@@ -222,7 +223,8 @@ struct EpochStats {
 EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clouds,
                     const std::vector<int>& order, TrainableDetector& detector,
                     const SelfTrainOptions& options, const ProgressCallback& progress,
-                    std::size_t progress_offset, std::size_t progress_total, int epoch) {
+                    std::size_t progress_offset, std::size_t progress_total, int epoch,
+                    std::vector<int>* pseudo_label_uses) {
   EpochStats stats;
   const PrincipalFrame frame = ModelPrincipalFrame(object);
   for (std::size_t start = 0; start < order.size(); start += options.batch) {
@@ -247,6 +249,7 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
       stats.certified += estimates[i].ok() && estimates[i].certificate.oc.passed;
       stats.ambiguous += ambiguous[i];
       if (usable[i]) {
+        ++(*pseudo_label_uses)[static_cast<std::size_t>(order[start + i])];
         certified_clouds.push_back(batch[i]);
         targets.push_back(estimates[i].keypoints);   // pseudo-label: corrected keypoints
       }
@@ -290,18 +293,47 @@ bool Better(const ValidationFit& candidate, const ValidationFit& best, double re
 SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
                           TrainableDetector& detector, const SelfTrainOptions& options,
                           const EpochCallback& on_epoch, const ProgressCallback& progress,
-                          bool resume, const SelfTrainReference* reference) {
+                          bool resume, const SelfTrainReference* reference, const std::vector<int>* groups) {
   options.Check();
   if (clouds.size() < 2) throw InputError("selftrain", "need at least 2 unlabelled clouds");
   if (reference != nullptr && reference->scene_from_model.size() != clouds.size()) {
     throw std::invalid_argument("SelfTrain: reference poses must match the clouds");
   }
+  if (groups != nullptr && groups->size() != clouds.size()) {
+    throw std::invalid_argument("SelfTrain: groups must match the clouds");
+  }
   // Deterministic split: a seeded shuffle, the first part held out.
   std::vector<int> all(clouds.size());
   std::iota(all.begin(), all.end(), 0);
   all = Shuffled(all, Rng::ForItem(options.seed, 0xC3B0));
-  const std::size_t validation_count = std::clamp<std::size_t>(
+  std::size_t validation_count = std::clamp<std::size_t>(
       static_cast<std::size_t>(std::lround(options.validation_fraction * clouds.size())), 1, clouds.size() - 1);
+  if (groups != nullptr) {
+    // Split by group (e.g. by image: the augmented copies of one real
+    // instance, and the instances of one image, are never on both sides):
+    // whole groups in a seeded order are held out until the validation part
+    // reaches its size; at least one group is held out and one trained on.
+    std::vector<int> distinct(groups->begin(), groups->end());
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    if (distinct.size() < 2) {
+      throw InputError("selftrain", "the clouds come from one image: need at least 2 to split into training and "
+                                    "validation");
+    }
+    distinct = Shuffled(distinct, Rng::ForItem(options.seed, 0xC3B0));
+    std::vector<std::vector<int>> members(distinct.size());
+    std::map<int, std::size_t> rank_of;
+    for (std::size_t r = 0; r < distinct.size(); ++r) rank_of[distinct[r]] = r;
+    for (int i : all) members[rank_of.at((*groups)[i])].push_back(i);
+    const std::size_t target = validation_count;
+    all.clear();
+    validation_count = 0;
+    for (std::size_t r = 0; r < members.size(); ++r) {
+      const bool held_out = r == 0 || (validation_count < target && r + 1 < members.size());
+      if (held_out) validation_count += members[r].size();
+      all.insert(all.end(), members[r].begin(), members[r].end());
+    }
+  }
   std::vector<PointSet> validation;
   std::vector<Pose> validation_truth;
   for (std::size_t k = 0; k < validation_count; ++k) {
@@ -315,6 +347,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   };
 
   SelfTrainResult result;
+  result.pseudo_label_uses.assign(clouds.size(), 0);
   std::vector<float> best_weights;
   int first_epoch = 1;
   int stale = 0;   // epochs in a row without a new best
@@ -330,6 +363,9 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     result.best = FitFromJson(state.at("best"));
     stale = state.at("stale");
     for (const auto& log : state.at("logs")) result.epochs.push_back(LogFromJson(log));
+    if (state.contains("pseudo_label_uses") && state.at("pseudo_label_uses").size() == clouds.size()) {
+      state.at("pseudo_label_uses").get_to(result.pseudo_label_uses);
+    }
     best_weights = LoadWeights(best_path, detector.GetWeights().size());
   } else {
     result.initial = measure();
@@ -352,7 +388,8 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     const auto start = std::chrono::steady_clock::now();
     const std::vector<int> order = Shuffled(train, Rng::ForItem(options.seed, epoch));
     const EpochStats stats = RunEpoch(object, clouds, order, detector, options, progress,
-                                      train.size() * (epoch - 1), progress_total, epoch);
+                                      train.size() * (epoch - 1), progress_total, epoch,
+                                      &result.pseudo_label_uses);
     if (epoch == 1 && stats.certified == 0) {
       throw InputError("selftrain", "no training cloud was observably correct in the first epoch: nothing to "
                                     "learn from (check eps_oc, the object, or train the detector on sim data first)");
@@ -396,7 +433,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
                     {"best_validation_detection_error", result.best_validation_detection_error},
                     {"initial_validation_percent_oc", result.initial_validation_percent_oc},
                     {"initial", FitJson(result.initial)}, {"best", FitJson(result.best)}, {"stale", stale},
-                    {"logs", json::array()}};
+                    {"logs", json::array()}, {"pseudo_label_uses", result.pseudo_label_uses}};
       for (const auto& l : result.epochs) state["logs"].push_back(LogJson(l));
       SaveWeights(best_path, best_weights);
       detector.SaveCheckpoint(options.checkpoint_path, state.dump());

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,8 +40,18 @@ std::string CloudName(std::size_t index) {
   return name;
 }
 
-DatasetEntry EntryOf(const SynthSample& sample, std::size_t index) {
+// The manifest's "object" label: the object's name, when it is a valid label.
+std::optional<std::string> LabelOf(const std::string& name) {
+  if (name.empty() || name.size() > 256) return std::nullopt;
+  for (unsigned char c : name) {
+    if (c < 0x20 || c == 0x7f) return std::nullopt;
+  }
+  return name;
+}
+
+DatasetEntry EntryOf(const SynthSample& sample, std::size_t index, const std::optional<std::string>& label) {
   DatasetEntry entry;
+  entry.object = label;
   entry.cloud = CloudName(index);
   entry.pose = sample.scene_from_model;
   entry.keypoints = sample.keypoints;
@@ -120,6 +131,7 @@ SynthReport WriteSynthDataset(const Mesh& mesh, const ObjectSpec& spec,
       mesh, spec.keypoints, options,
       !where.empty() ? where : spec.name.empty() ? std::string("object") : spec.name);
   DatasetWriter writer(dir);
+  const std::optional<std::string> label = LabelOf(spec.name);
   const int workers = std::max(1, DefaultThreadCount());
   auto renderers = MakeRenderers(generator, workers);
   const std::size_t count = static_cast<std::size_t>(options.count);
@@ -133,7 +145,7 @@ SynthReport WriteSynthDataset(const Mesh& mesh, const ObjectSpec& spec,
     const std::size_t end = std::min(last, begin + batch);
     RunBatch(generator, begin, end, renderers, [&](std::size_t i, const SynthSample& sample) {
       stats[i - begin] = StatsOf(sample);
-      writer.Add(i, EntryOf(sample, i), sample.cloud);   // thread-safe
+      writer.Add(i, EntryOf(sample, i, label), sample.cloud);   // thread-safe
     });
     ThrowIfInterrupted();
     for (std::size_t i = begin; i < end; ++i) accumulator.Add(stats[i - begin]);

@@ -127,6 +127,22 @@ struct EvaluationRow {
   RowSummary summary;
 };
 
+// Mixed datasets (manifest "object" labels, dataset.hpp): per detector and
+// object label, how many clouds detector + corrector + certificates accepted.
+// For the evaluated object itself these are its corrector (or C-3PO) row's
+// counts; another object's clouds are certified as if they showed the
+// evaluated object, and every accepted one is a false certificate in the
+// sense of the paper's Section VIII-E (the certificate must reject them).
+struct ObjectAcceptance {
+  std::string detector;                // detector label
+  std::string object;                  // manifest label
+  bool evaluated_object = false;       // the object being evaluated
+  int clouds = 0;
+  int failures = 0;                    // no pose (unreadable cloud, detector failure)
+  int observably_correct = 0;
+  int certified = 0;                   // accepted: oc and nd
+};
+
 struct Evaluation {
   std::string object_name;
   std::string dataset_dir;
@@ -134,8 +150,12 @@ struct Evaluation {
   double diameter = 0.0;
   EvaluationOptions options;           // absolute thresholds used
   std::vector<EvaluationRow> rows;
+  // Datasets with other objects' clouds only (empty otherwise): this object
+  // first, then the other labels in name order, for each detector.
+  std::vector<ObjectAcceptance> objects;
   int total_false_certificates() const;
   int total_false_certificates_hausdorff() const;
+  int other_objects_accepted() const;  // certified clouds of other objects, all detectors
   // The row whose examples a report shows: the first C-3PO row on all clouds,
   // else the first corrector row, else the first row; nullptr without rows.
   const EvaluationRow* MainRow() const;
@@ -152,7 +172,10 @@ EvaluationRow MakeEvaluationRow(EvalMethod method, EvalSubset subset, const std:
                                 double diameter);
 
 // Runs every detector on every cloud of the dataset (in parallel over clouds)
-// and returns the rows in the order: for each detector, its KeyPo, + ICP,
+// that shows the object (Dataset::Shows: no label or the object's name; the
+// rows' sample indices are the dataset's entries; in a mixed dataset the other
+// labels' clouds only fill Evaluation::objects; InputError when no cloud shows
+// the object) and returns the rows in the order: for each detector, its KeyPo, + ICP,
 // + RANSAC + ICP, + corrector rows (or its three C-3PO rows when self-trained). Throws
 // InputError("dir/manifest.jsonl: ...") when an entry has no ground-truth pose
 // or, for a manifest detector, no detected_keypoints; std::invalid_argument

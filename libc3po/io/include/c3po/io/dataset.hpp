@@ -3,7 +3,11 @@
 // the manifest line schema below; writing is dataset_writer.hpp).
 // Line: {"cloud": "000000.ply"} plus optional ground truth "R" (3x3 rows),
 // "t", "keypoints" (posed, N x 3), "detected_keypoints" (N x 3) and
-// "visible" (N booleans, for rendered depth clouds).
+// "visible" (N booleans, for rendered depth clouds), and "object" (the name
+// of the object the cloud shows: a label for mixed datasets, e.g. several
+// objects' clouds joined by `c3po merge --prefix-parts`; ground truth and
+// keypoints are that object's, and the keypoint count must agree only among
+// lines of the same object).
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +22,7 @@ struct DatasetEntry {
   std::optional<PointSet> keypoints;          // ground-truth posed keypoints, 3 x N
   std::optional<PointSet> detected_keypoints; // 3 x N, from an outside detector
   std::optional<std::vector<bool>> visible;   // per keypoint
+  std::optional<std::string> object;          // label: the object's name (1-256 printable characters)
 };
 
 struct Dataset {
@@ -27,6 +32,9 @@ struct Dataset {
   std::string CloudPath(std::size_t i) const;   // dir / entries[i].cloud
   PointSet LoadCloud(std::size_t i) const;      // ReadCloud(CloudPath(i))
   bool HasGroundTruth() const;                  // every entry has pose + keypoints
+  // True when entry i shows `object_name`: its label is that name, or it has
+  // no label (a single-object dataset).
+  bool Shows(std::size_t i, const std::string& object_name) const;
 };
 
 // Throws InputError("dir/manifest.jsonl: line 3: field: problem") for

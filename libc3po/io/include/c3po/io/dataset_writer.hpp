@@ -48,6 +48,11 @@ class DatasetWriter {
 // `dir` through DatasetWriter: manifest lines in part order, clouds rewritten
 // as binary PLY under their names. Returns the number of clouds. Throws
 // InputError for unreadable parts or a cloud name in two parts.
-std::size_t MergeDatasets(const std::vector<std::string>& parts, const std::string& dir);
+// `prefix_parts`: every cloud goes under a subfolder named after its part's
+// folder ("drill_depth/000000.ply"), so datasets with the same cloud names (e.g.
+// several objects' synth outputs: a mixed dataset, whose lines keep their
+// "object" labels) can be joined; two parts with the same folder name are
+// then refused.
+std::size_t MergeDatasets(const std::vector<std::string>& parts, const std::string& dir, bool prefix_parts = false);
 
 }  // namespace c3po

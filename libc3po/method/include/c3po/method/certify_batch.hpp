@@ -58,6 +58,12 @@ std::vector<CloudSource> DatasetSources(const Dataset& dataset);
 std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
                                          const std::vector<PointSet>& keypoints = {});
 
+// Reads one source's cloud as CertifyBatch does: `load`, or `load_segment`
+// (image inputs) whose preprocessing counts go to `segment_counts` (when not
+// null) before a segment too small to use is refused. Throws InputError
+// naming the source (unreadable file, empty or too small segment).
+PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts = nullptr);
+
 struct CertifyBatchOptions {
   PipelineOptions pipeline;           // corrector + certificate thresholds (absolute)
   // --eps-oc auto: after every cloud is certified, eps_oc is estimated from

@@ -86,6 +86,10 @@ struct SelfTrainResult {
   ValidationFit initial;              // the model before self-training
   ValidationFit best;                 // the kept model
   bool stopped_early = false;
+  // Per cloud (input order): how many training steps used its pseudo-label
+  // (0 for held-out clouds and for clouds never certified unambiguously):
+  // the evidence that, in mixed data, another object's clouds taught nothing.
+  std::vector<int> pseudo_label_uses;
 };
 
 // Optional ground truth for reporting (same length as the clouds); selection
@@ -102,10 +106,15 @@ using EpochCallback = std::function<void(const SelfTrainEpochLog&)>;
 // Self-trains `detector` in place; on return it holds the best weights.
 // Throws InputError when no sample certifies in the first epoch (nothing to
 // learn from). With options.checkpoint_path, `resume` continues from it.
+// `groups` (same length as the clouds, e.g. the image of each real instance
+// and its augmented copies, selftrain_inputs.hpp): the validation split takes
+// whole groups (InputError with fewer than 2 groups); nullptr = every cloud
+// its own group.
 SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
                           TrainableDetector& detector, const SelfTrainOptions& options,
                           const EpochCallback& on_epoch = {}, const ProgressCallback& progress = {},
-                          bool resume = false, const SelfTrainReference* reference = nullptr);
+                          bool resume = false, const SelfTrainReference* reference = nullptr,
+                          const std::vector<int>* groups = nullptr);
 
 // The validation criteria of `detector` on `clouds` (truth optional, for the
 // reporting fields).

@@ -1,0 +1,56 @@
+#pragma once
+// What self-training learns from when its clouds come from cameras (issue 18
+// part 3; docs/method.md "Self-training on real frames"): the CloudSources of
+// the one batch path (certify_batch.hpp, image_sources.hpp: --bop, --depth /
+// --mask, datasets), read into memory with the image each came from, then the
+// paper's augmentation (Section VIII-D): several copies of every real
+// instance, each with 10 % of its points dropped and 1 mm Gaussian noise added.
+// The image is the unit of the validation split (SelfTrain's `groups`), so no
+// copy of a held-out image's instance is trained on.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "c3po/base/types.hpp"
+#include "c3po/method/certify_batch.hpp"
+
+namespace c3po {
+
+struct AugmentOptions {
+  int copies = 1;                // augmented copies per instance (0 = the instances as read, unchanged)
+  double drop_fraction = 0.1;    // points dropped from each copy (the same count for every copy of a cloud)
+  double noise_sigma = 0.001;    // Gaussian noise per coordinate, object units (1 mm for metre objects)
+  std::uint64_t seed = 0;        // copy c of instance i draws from Rng::ForItem(seed, i * copies + c)
+  void Check() const;            // throws std::invalid_argument
+};
+
+// Unlabelled clouds with their provenance. groups[i]: the validation unit of
+// clouds[i] (one per image for BOP sources, keyed (scene_id, im_id); one per
+// source otherwise). truth[i]: the source's ground truth (reporting only).
+// labels[i]: the object the cloud shows when known ("obj_000005" for a BOP
+// instance of obj_id 5, the name annotate gives models/obj_000005.ply; a
+// manifest's "object"), "" otherwise; never used for training, only to
+// report what a mixed dataset's clouds of each object taught.
+struct UnlabelledClouds {
+  std::vector<PointSet> clouds;
+  std::vector<int> groups;
+  std::vector<std::optional<Pose>> truth;
+  std::vector<std::string> names;
+  std::vector<std::string> labels;
+  std::vector<std::string> skipped;   // sources that could not be read: the InputError text
+  bool AllHaveTruth() const;          // non-empty and every cloud has a truth
+};
+
+// Reads every source with LoadSourceCloud (in parallel); a source that cannot
+// be read (e.g. a segment with no valid depth) is skipped and its error kept.
+UnlabelledClouds LoadUnlabelledClouds(const std::vector<CloudSource>& sources);
+
+// `copies` augmented copies of every cloud (in order: instance 0's copies,
+// then instance 1's, ...), each keeping its instance's group, truth and name
+// (+ "#c"). A copy keeps n - round(drop_fraction * n) points (at least 1, in
+// their original order) and adds N(0, noise_sigma^2) to every coordinate.
+// std::invalid_argument when the per-cloud vectors differ in length.
+UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions& options);
+
+}  // namespace c3po
