@@ -257,6 +257,14 @@ int Run(const EvalCommand& cmd) {
   // --shard by manifest line (a BOP run was sharded above).
   if (shard && cmd.bop.dir.empty()) dataset = ShardDataset(dataset, *shard);
   if (shard && dataset.entries.empty()) throw InputError("--shard " + cmd.shard, empty_part);
+  if (!cmd.samples_path.empty()) {   // sample files hold the object's rows, not a mixed set's per-object counts
+    for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
+      if (!dataset.Shows(i, object.name())) {
+        throw InputError(data_dir, "--samples: the dataset holds other objects' clouds (a mixed set); sample files "
+                                   "do not carry its per-object acceptance, so evaluate a mixed set unsharded");
+      }
+    }
+  }
   const std::vector<LoadedDetector> loaded = LoadDetectors(cmd, object);
   std::vector<EvaluatedDetector> detectors;
   for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});

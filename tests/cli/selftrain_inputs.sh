@@ -63,6 +63,11 @@ expect_error frame_half "--mask" --depth bop/test/000000/depth/000000.png
 grep -q "(8 clouds)" eval.out || fail "eval on mixed: rows not on the mug's 8 clouds: $(head -1 eval.out)"
 grep -q "svd: box .* of 8 accepted" eval.out || fail "eval on mixed: no per-object line for the box: $(tail -4 eval.out)"
 grep -q '"other_objects_accepted"' eval.json || fail "eval --json on mixed: no other_objects_accepted"
+"$C3PO" eval "$MUG" --detector svd --data mixed --no-icp --samples s.jsonl > evals.out 2>&1
+status=$?
+[ $status -eq 2 ] || fail "eval --samples on a mixed set: exit $status, expected 2"
+grep -q "mixed" evals.out || fail "eval --samples on a mixed set: no reason given: $(tail -1 evals.out)"
+[ ! -e s.jsonl ] || fail "eval --samples on a mixed set wrote a samples file"
 "$C3PO" selftrain "$MUG" --model mug.model --data mixed --epochs 1 --eps-oc 3%d -o mixself.model > mixself.out 2> mixself.err
 status=$?
 if [ $status -eq 0 ]; then
