@@ -82,6 +82,9 @@ struct CloudOutcome {
   // Image inputs: the preprocessing counts (segment.hpp; `cloud` emptied),
   // also when the segment was too small to use (failure kLoad).
   std::optional<SegmentCloud> segment;
+  // Hausdorff(T*·B̂, T̂·B̂) when the source has a ground-truth pose (the
+  // correctness measure of docs/method.md: symmetries cost nothing).
+  std::optional<double> truth_hausdorff;
   double seconds = 0.0;               // reading + preprocessing + detection + estimate
   bool processed() const { return failure == Failure::kNone; }
   bool certified() const { return processed() && estimate.certified(); }
