@@ -88,9 +88,13 @@ void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, Co
     throw InputError("--global-steps", std::to_string(flags.global_steps) + " must be even and in [2, 36]");
   }
   certificate->free_space.enabled = !flags.no_free_space;
-  if (flags.free_space_fraction >= 0) {
-    if (!(flags.free_space_fraction < 1)) throw InputError("--free-space-fraction", "must be in [0, 1)");
-    certificate->free_space.max_fraction = flags.free_space_fraction;
+  if (!flags.free_space_fraction.empty()) {
+    char* end = nullptr;
+    const double value = std::strtod(flags.free_space_fraction.c_str(), &end);
+    if (*end != '\0' || !(value >= 0) || !(value < 1)) {
+      throw InputError("--free-space-fraction", "'" + flags.free_space_fraction + "' must be a number in [0, 1)");
+    }
+    certificate->free_space.max_fraction = value;
   }
 }
 
@@ -121,7 +125,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (flags.no_global_check) line += " --no-global-check";
   if (flags.global_steps != 4) line += " --global-steps " + std::to_string(flags.global_steps);
   if (flags.no_free_space) line += " --no-free-space";
-  if (flags.free_space_fraction >= 0) line += " --free-space-fraction " + std::to_string(flags.free_space_fraction);
+  if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;
   return line;
 }
 

@@ -60,7 +60,7 @@ struct RobustFlags {
   bool no_global_check = false;    // --no-global-check: nd without the rival search
   int global_steps = 4;            // --global-steps
   bool no_free_space = false;      // --no-free-space (depth-image inputs)
-  double free_space_fraction = -1; // --free-space-fraction ( < 0: default)
+  std::string free_space_fraction; // --free-space-fraction ("" = default)
 };
 void AddRobustOptions(CLI::App& command, RobustFlags* flags);
 // Fills the certificate's budget and local test and the corrector's kernel

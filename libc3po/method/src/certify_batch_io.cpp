@@ -95,6 +95,8 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["rival_outliers"] = g.rival_outliers;
   line["rival_axis"] = g.rival_axis;
   line["rival_angle_deg"] = g.rival_angle_deg;
+  line["rival_passes_oc"] = g.rival_passes_oc;
+  line["rival_free_space_violations"] = g.rival_free_space_violations;
   // Free space (depth-image inputs, free_space.hpp); null when not checked.
   const FreeSpace& f = e.certificate.free_space;
   line["free_space"] = f.checked ? nlohmann::ordered_json(f.passed) : nlohmann::ordered_json(nullptr);

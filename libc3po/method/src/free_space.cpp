@@ -36,21 +36,33 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   result.checked = true;
   renderer_->Render(object_.mesh(), camera_from_model);
   const DepthImage& depth = *view_.depth;
-  const int w = depth.width, h = depth.height, r = options_.border_pixels;
-  const auto covered = [&](int u, int v) { return u >= 0 && v >= 0 && u < w && v < h && renderer_->TriangleAt(u, v) >= 0; };
+  const int w = depth.width, h = depth.height;
+  const double focal = std::max(view_.camera.fx, view_.camera.fy);
+  // A pixel is counted only on a smooth part of the rendered surface: the
+  // samples at distances r and r/2 around it are covered and their rendered
+  // depth is within the tolerance of its own. r = border_pixels + the image
+  // shift of a tolerance-sized motion at this depth (f·τ/z): a pose within
+  // the tolerance moves silhouette and self-occlusion edges by at most that.
+  const auto smooth = [&](int u, int v, int du, int dv, double z) {
+    if (u + du < 0 || v + dv < 0 || u + du >= w || v + dv >= h) return false;
+    return renderer_->TriangleAt(u + du, v + dv) >= 0 && std::abs(renderer_->DepthAt(u + du, v + dv) - z) <= tolerance_;
+  };
   for (const int pixel : renderer_->covered_pixels()) {
     const int u = pixel % w, v = pixel / w;
-    // Interior: the 8 pixels at distance r (square) are covered too.
+    const double z = renderer_->DepthAt(u, v);
+    const int r = options_.border_pixels + static_cast<int>(std::ceil(focal * tolerance_ / std::max(z, 1e-3)));
     bool interior = true;
-    for (int du = -r; du <= r && interior; du += std::max(r, 1)) {
-      for (int dv = -r; dv <= r && interior; dv += std::max(r, 1)) interior = covered(u + du, v + dv);
+    for (const int step : {r, (r + 1) / 2}) {
+      for (int du = -step; du <= step && interior; du += step) {
+        for (int dv = -step; dv <= step && interior; dv += step) interior = smooth(u, v, du, dv, z);
+      }
     }
     if (!interior) continue;
     ++result.silhouette;
     const float observed = depth.at(u, v);
     if (!DepthImage::Valid(observed)) continue;
     ++result.measured;
-    if (observed > renderer_->DepthAt(u, v) + tolerance_) ++result.violations;
+    if (observed > z + tolerance_) ++result.violations;
   }
   result.passed = result.violations <= options_.max_fraction * result.measured;
   return result;

@@ -18,6 +18,9 @@ void GlobalUniquenessOptions::Check() const {
   if (!(rival_distance >= 0.0 && std::isfinite(rival_distance))) {
     throw std::invalid_argument("global uniqueness rival distance must be >= 0");
   }
+  if (!(rival_extra_fraction >= 0.0 && rival_extra_fraction < 1.0)) {
+    throw std::invalid_argument("global uniqueness rival slack must be in [0, 1)");
+  }
 }
 
 PrincipalFrame ModelPrincipalFrame(const ObjectModel& object) {
@@ -64,7 +67,12 @@ std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cl
   PipelineOptions rival_options = pipeline;
   rival_options.correct = true;   // a rival is where the corrector settles from the turned start
   rival_options.certificate.global.enabled = false;
-  rival_options.certificate.local_nondegeneracy = false;   // only the rival's oc_m is needed
+  rival_options.certificate.local_nondegeneracy = false;   // only the rival's oc is needed
+  // The rivals' budget: m + the slack (global_uniqueness.hpp).
+  const int m = pipeline.certificate.max_outliers.Resolve(cloud.cols());
+  rival_options.certificate.max_outliers = OutlierBudget{};
+  rival_options.certificate.max_outliers.count =
+      m + static_cast<int>(std::floor(pipeline.certificate.global.rival_extra_fraction * cloud.cols()));
   const PointSet queries = StridedColumns(object.sample(), 1000);
   std::vector<RivalFit> fits;
   fits.reserve(hypotheses.size());

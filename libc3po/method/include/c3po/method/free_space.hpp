@@ -6,9 +6,11 @@
 // `tolerance` is a ray the camera saw through where the (opaque) object would
 // be. Occluders in front are fine; pixels without depth are unknown. The
 // test passes when such pixels are at most `max_fraction` of the silhouette
-// pixels that have a measurement. Silhouette pixels within `border_pixels` of
-// the silhouette's edge are not counted (a pose within eps_oc moves the
-// outline by a few pixels onto the background). Used on the estimate
+// pixels that have a measurement. Only pixels on smooth parts of the rendered
+// surface count: farther than border_pixels + f·tolerance/z pixels from the
+// silhouette's edge and from self-occlusion edges (a pose within the
+// tolerance moves every edge by at most that many pixels; a mug's rim or a
+// marker seen edge-on would otherwise fail correct poses). Used on the estimate
 // (Certificate::free_space) and on every rival of the global test (a rival
 // that violates free space is not a rival).
 #include <memory>
@@ -26,7 +28,7 @@ struct FreeSpaceOptions {
   double tolerance = 0.0;      // metres behind the surface; 0 = max(eps_oc, min_tolerance)
   double min_tolerance = 0.01; // floor of the automatic tolerance (real depth noise, mask edges)
   double max_fraction = 0.1;   // of the measured interior silhouette pixels
-  int border_pixels = 3;       // silhouette pixels this close to its edge are not counted
+  int border_pixels = 3;       // plus f·tolerance/z: pixels this close to a rendered edge are not counted
   void Check() const;          // throws std::invalid_argument
 };
 

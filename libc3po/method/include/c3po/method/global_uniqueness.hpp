@@ -37,7 +37,13 @@ struct GlobalUniquenessOptions {
   // that proves one of them wrong. eps_w is unknown; 2·eps_oc <= 2(eps_oc +
   // eps_w) refuses at least every such rival (docs/method.md).
   double rival_distance = 0.0;
-  void Check() const;   // steps even and in [2, 36], rival_distance >= 0 finite
+  // Rivals are judged with a looser oc than the estimate: at most m +
+  // rival_extra_fraction·n points beyond eps_oc (n = cloud size). The
+  // estimate must beat every far pose by more than a few noisy points can
+  // explain (measured: a large marker whose true, flipped pose had 3 points
+  // beyond eps_oc while the wrong one had none). 0 = exactly oc_m.
+  double rival_extra_fraction = 0.01;
+  void Check() const;   // steps even and in [2, 36], rival_distance >= 0 finite, fraction in [0, 1)
 };
 
 // The evidence (part of NonDegeneracy, certificate.hpp).
@@ -45,7 +51,7 @@ struct GlobalUniqueness {
   bool passed = true;
   double rival_distance = 0.0;  // the threshold used (object units)
   int rivals_tried = 0;
-  int rivals_found = 0;         // distinct rivals passing oc_m (and free space)
+  int rivals_found = 0;         // distinct rivals passing the rivals' oc (and free space)
   // The rival reported: the farthest one that counts; if none counts, the
   // distinct one (farther than rival_distance) with the fewest outliers;
   // axis -1 when every rival fell back within rival_distance of T̂.
@@ -79,7 +85,7 @@ struct RivalFit {
   bool ok = false;                // the corrector returned a pose
   Pose scene_from_model;
   PointSet keypoints;             // corrected keypoints of the rival
-  bool passes_oc = false;         // oc_m with the estimate's eps_oc and budget
+  bool passes_oc = false;         // oc with the estimate's eps_oc and budget m (+ the rival slack, see above)
   int outliers = 0;
   double budget_distance = 0.0;
   double keypoint_distance = 0.0; // max_i ||y*_i - y'_i||
