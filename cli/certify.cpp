@@ -166,6 +166,11 @@ int Run(const CertifyCommand& cmd) {
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
   ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
+  // Depth-image / BOP input: the measured default budget (docs/method.md
+  // "Measured on real frames"), printed in the summary and in every JSON line.
+  if (cmd.robust.max_outliers.empty() && (cmd.frame.given() || !cmd.bop.dir.empty())) {
+    options.pipeline.certificate.max_outliers.fraction = kDepthImageOutlierFraction;
+  }
   options.auto_eps_oc = cmd.thresholds.auto_eps_oc();
   if (options.auto_eps_oc && !cmd.shard.empty()) {
     throw InputError("--eps-oc", "auto estimates the threshold from all clouds of a run; with --shard give a value");

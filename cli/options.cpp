@@ -67,7 +67,7 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                    "Depth-image inputs: no free-space test (on by default)");
   command.add_option("--free-space-fraction", flags->free_space_fraction,
                      "Depth-image inputs: largest fraction of the measured silhouette pixels seen behind the posed "
-                     "model (default 0.1)");
+                     "model (default 0.05)");
 }
 
 void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, CorrectorOptions* corrector) {

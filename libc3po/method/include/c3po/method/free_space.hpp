@@ -6,11 +6,12 @@
 // `tolerance` is a ray the camera saw through where the (opaque) object would
 // be. Occluders in front are fine; pixels without depth are unknown. The
 // test passes when such pixels are at most `max_fraction` of the silhouette
-// pixels that have a measurement. Only pixels on smooth parts of the rendered
-// surface count: farther than border_pixels + f·tolerance/z pixels from the
-// silhouette's edge and from self-occlusion edges (a pose within the
-// tolerance moves every edge by at most that many pixels; a mug's rim or a
-// marker seen edge-on would otherwise fail correct poses). Used on the estimate
+// pixels that have a measurement. A pose within the tolerance shifts the
+// image by at most r = border_pixels + f·tolerance/z pixels: pixels within r
+// of the silhouette's edge are not counted, and a pixel violates only when
+// its observed depth is behind the farthest rendered depth within r (plus
+// the tolerance), so self-occlusion edges (a mug's rim over its inside) and
+// curved surfaces do not fail correct poses. Used on the estimate
 // (Certificate::free_space) and on every rival of the global test (a rival
 // that violates free space is not a rival).
 #include <memory>
@@ -27,7 +28,10 @@ struct FreeSpaceOptions {
   bool enabled = true;
   double tolerance = 0.0;      // metres behind the surface; 0 = max(eps_oc, min_tolerance)
   double min_tolerance = 0.01; // floor of the automatic tolerance (real depth noise, mask edges)
-  double max_fraction = 0.1;   // of the measured interior silhouette pixels
+  // Of the measured counted pixels. Measured (docs/method.md): <= 3.0 % at
+  // every correct real YCB-V pose, <= 1.6 % at correct artefact-scene poses
+  // that pass oc; 7-10 % for a mustard bottle posed on other objects' segments.
+  double max_fraction = 0.05;
   int border_pixels = 3;       // plus f·tolerance/z: pixels this close to a rendered edge are not counted
   void Check() const;          // throws std::invalid_argument
 };
