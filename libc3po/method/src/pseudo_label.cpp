@@ -25,7 +25,11 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
   if (!options.check_ambiguity || !estimate.ok()) return check;
   const double eps_oc = pipeline.certificate.eps_oc;
   const std::vector<std::pair<int, double>> half_turns = {{0, M_PI}, {1, M_PI}, {2, M_PI}};
-  for (const RivalFit& rival : RefineRivals(object, cloud, estimate, pipeline, frame, half_turns)) {
+  // This rule judges rivals by exactly oc_m (no slack: the residual ratio
+  // below is its own margin).
+  PipelineOptions exact = pipeline;
+  exact.certificate.global.rival_extra_fraction = 0.0;
+  for (const RivalFit& rival : RefineRivals(object, cloud, estimate, exact, frame, half_turns)) {
     if (!rival.ok) continue;
     if (rival.keypoint_distance <= eps_oc) continue;   // the same basin
     const double residual = FitResidual(object, cloud, rival.scene_from_model);
