@@ -59,6 +59,15 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_option("--nd-min-eigenvalue", flags->nd_min_eigenvalue,
                      "Local non-degeneracy threshold on the smallest generalised eigenvalue (data vs model "
                      "point-to-plane information); 0 = local test off");
+  command.add_flag("--no-global-check", flags->no_global_check,
+                   "nd without the global rival search (restarts of the corrector at turned poses; on by default)");
+  command.add_option("--global-steps", flags->global_steps,
+                     "Rival starts: rotations by k*360/N deg about each principal axis (N even, default 4)");
+  command.add_flag("--no-free-space", flags->no_free_space,
+                   "Depth-image inputs: no free-space test (on by default)");
+  command.add_option("--free-space-fraction", flags->free_space_fraction,
+                     "Depth-image inputs: largest fraction of the measured silhouette pixels seen behind the posed "
+                     "model (default 0.05)");
 }
 
 void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, CorrectorOptions* corrector) {
@@ -73,10 +82,24 @@ void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, Co
     certificate->local_nondegeneracy = value > 0;
     if (value > 0) certificate->local.min_eigenvalue = value;
   }
+  certificate->global.enabled = !flags.no_global_check;
+  certificate->global.steps = flags.global_steps;
+  if (flags.global_steps < 2 || flags.global_steps > 36 || flags.global_steps % 2 != 0) {
+    throw InputError("--global-steps", std::to_string(flags.global_steps) + " must be even and in [2, 36]");
+  }
+  certificate->free_space.enabled = !flags.no_free_space;
+  if (!flags.free_space_fraction.empty()) {
+    char* end = nullptr;
+    const double value = std::strtod(flags.free_space_fraction.c_str(), &end);
+    if (*end != '\0' || !(value >= 0) || !(value < 1)) {
+      throw InputError("--free-space-fraction", "'" + flags.free_space_fraction + "' must be a number in [0, 1)");
+    }
+    certificate->free_space.max_fraction = value;
+  }
 }
 
 std::string DescribeRobust(const CertificateOptions& certificate, const CorrectorOptions& corrector) {
-  char text[160];
+  char text[200];
   if (certificate.local_nondegeneracy) {
     std::snprintf(text, sizeof text, "m = %s, robust loss = %s, local nd >= %g",
                   certificate.max_outliers.ToString().c_str(), ToString(corrector.robust_loss),
@@ -85,7 +108,13 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
     std::snprintf(text, sizeof text, "m = %s, robust loss = %s, local nd off",
                   certificate.max_outliers.ToString().c_str(), ToString(corrector.robust_loss));
   }
-  return text;
+  std::string described = text;
+  if (certificate.global.enabled) {
+    described += ", global rivals " + std::to_string(3 * (certificate.global.steps - 1));
+  } else {
+    described += ", global check off";
+  }
+  return described;
 }
 
 std::string RobustCommandLine(const RobustFlags& flags) {
@@ -93,6 +122,10 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (!flags.max_outliers.empty()) line += " --max-outliers " + flags.max_outliers;
   if (flags.robust_loss != "none") line += " --robust-loss " + flags.robust_loss;
   if (!flags.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + flags.nd_min_eigenvalue;
+  if (flags.no_global_check) line += " --no-global-check";
+  if (flags.global_steps != 4) line += " --global-steps " + std::to_string(flags.global_steps);
+  if (flags.no_free_space) line += " --no-free-space";
+  if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;
   return line;
 }
 

@@ -57,6 +57,10 @@ struct RobustFlags {
   std::string max_outliers;        // "" = the source's default (0 for ready-made clouds)
   std::string robust_loss = "none";
   std::string nd_min_eigenvalue;   // "" = default; 0 = local test off
+  bool no_global_check = false;    // --no-global-check: nd without the rival search
+  int global_steps = 4;            // --global-steps
+  bool no_free_space = false;      // --no-free-space (depth-image inputs)
+  std::string free_space_fraction; // --free-space-fraction ("" = default)
 };
 void AddRobustOptions(CLI::App& command, RobustFlags* flags);
 // Fills the certificate's budget and local test and the corrector's kernel

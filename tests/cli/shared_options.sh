@@ -18,7 +18,8 @@ commands=("certify" "eval" "bench corrector")
 for c in "${commands[@]}"; do
   # shellcheck disable=SC2086
   "$C3PO" $c --help > "help.txt" 2>&1 || fail "$c --help exited $?"
-  for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue; do
+  for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue --no-global-check \
+      --global-steps --no-free-space --free-space-fraction; do
     grep -q -- "$flag" help.txt || fail "$c --help lacks $flag"
   done
   grep -q "allow_extra_args\|->" help.txt && fail "$c --help shows code: $(grep 'allow_extra_args\|->' help.txt)"

@@ -70,6 +70,13 @@ done
 check robust_loss_bad "2" - --robust-loss one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --robust-loss huber one_point.xyz
 check robust_loss_max "2" - "robust kernel" one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --robust-loss tls --loss max one_point.xyz
 check nd_eigenvalue_bad "2" - --nd-min-eigenvalue one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --nd-min-eigenvalue nan one_point.xyz
+# Global rival search and free space (issue 16).
+for bad in 3 0 40 -2; do
+  check "global_steps_${bad}" "2" - --global-steps one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --global-steps "$bad" one_point.xyz
+done
+for bad in nan -0.5 1 abc; do
+  check "free_space_fraction_${bad}" "2" - --free-space-fraction one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --free-space-fraction "$bad" one_point.xyz
+done
 python3 -c "
 import sys
 print('0.25 0.5 0.75\n' * 500, end='')" > duplicates.xyz

@@ -343,7 +343,12 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "outliers", "outlier_indices", "outlier_indices_truncated",
                                          "distance_quantiles", "max_inlier_distance", "keypoint_support",
                                          "nd_set_support", "nd_sets", "nd_local", "nd_local_eigenvalue",
-                                         "nd_local_motion", "nd_local_rank", "ms"});
+                                         "nd_local_motion", "nd_local_rank", "nd_global", "rivals_tried",
+                                         "rivals_found", "rival_distance", "rival_hausdorff", "rival_outliers",
+                                         "rival_axis", "rival_angle_deg", "rival_passes_oc",
+                                         "rival_free_space_violations", "free_space", "free_space_violations",
+                                         "free_space_measured", "free_space_silhouette", "free_space_tolerance",
+                                         "ms"});
   CHECK(j["cloud"] == "a.ply");
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) CHECK(j["R"][r][c].get<double>() == e.scene_from_model.R(r, c));
@@ -375,6 +380,16 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   REQUIRE(j["nd_local_motion"].size() == 6);
   for (int k = 0; k < 6; ++k) CHECK(j["nd_local_motion"][k].get<double>() == nd.local.motion(k));
   CHECK(j["nd_local_rank"].get<int>() == nd.local.model_rank);
+  // The global rival search ran (everything else passed) and is reported.
+  if (e.certificate.oc.passed && nd.sets_passed && nd.local.passed) {
+    REQUIRE(nd.global_checked);
+    CHECK(j["nd_global"].get<bool>() == nd.global.passed);
+    CHECK(j["rivals_tried"].get<int>() == nd.global.rivals_tried);
+    CHECK(j["rivals_found"].get<int>() == nd.global.rivals_found);
+  } else {
+    CHECK(j["nd_global"].is_null());
+  }
+  CHECK(j["free_space"].is_null());   // a ready-made cloud: no depth frame
   // Outlier indices are capped at kMaxListedOutliers; the count stays exact.
   PoseEstimate many = e;
   many.certificate.oc.outlier_indices.resize(kMaxListedOutliers + 5);

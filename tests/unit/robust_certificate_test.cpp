@@ -10,6 +10,7 @@
 #include "c3po/method/auto_threshold.hpp"
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"
+#include "c3po/method/pipeline.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/method/local_nondegeneracy.hpp"
 #include "c3po/eval/metrics.hpp"
@@ -455,7 +456,7 @@ TEST_CASE("soundness: no certificate for a pose beyond the bound when at most m 
   const double eps_s = 2.0 * object.SampleSpacing();
   const double bound = object.spec().eps_oc + eps_w + 2 * eps_s;
   const PointSet queries = StridedColumns(object.sample(), 3000);
-  int certified = 0, candidates = 0;
+  int certified = 0, candidates = 0, rival_searches = 0, rivals_found = 0;
   for (std::uint64_t seed = 1; seed <= 24; ++seed) {
     CAPTURE(seed);
     const Scene scene = RenderScene(object, 1000 + seed, noise, 500);
@@ -483,16 +484,30 @@ TEST_CASE("soundness: no certificate for a pose beyond the bound when at most m 
       if (result.ok()) poses.push_back({result.scene_from_model, result.keypoints});
     }
     poses.push_back({wrong, wrong * object.keypoints()});
+    // The whole certificate, with the global rival search (pipeline.hpp).
+    PipelineOptions pipeline;
+    pipeline.corrector = corrector;
+    pipeline.certificate = options;
     for (const auto& [pose, keypoints] : poses) {
       ++candidates;
-      const Certificate certificate = Certify(object, cloud, pose, keypoints, options);
-      if (!certificate.certified()) continue;
+      PoseEstimate estimate;
+      estimate.scene_from_model = pose;
+      estimate.keypoints = keypoints;
+      estimate.certificate = Certify(object, cloud, pose, keypoints, options);
+      CompleteCertificate(object, cloud, pipeline, nullptr, &estimate);
+      if (estimate.certificate.nd.global_checked) {
+        ++rival_searches;
+        rivals_found += estimate.certificate.nd.global.rivals_found > 0;
+      }
+      if (!estimate.certified()) continue;
       ++certified;
       const double hausdorff = PosedModelHausdorff(object, queries, scene.truth, pose);
       CHECK(hausdorff < bound);
     }
   }
-  MESSAGE("soundness: " << certified << " of " << candidates << " candidate poses certified");
+  MESSAGE("soundness: " << certified << " of " << candidates << " candidate poses certified; " << rival_searches
+                         << " rival searches, " << rivals_found << " found a rival");
+  CHECK(rival_searches >= certified);   // every certified pose went through the global search
   CHECK(candidates > 40);
   CHECK(certified > 10);   // the test must exercise certified poses, not only rejections
 }

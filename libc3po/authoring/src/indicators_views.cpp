@@ -62,8 +62,13 @@ std::vector<Eigen::Matrix3d> CubeGroup() {
   return group;
 }
 
-// Centroid and principal axes (columns, right-handed) of the object's surface sample.
-std::pair<Eigen::Vector3d, Eigen::Matrix3d> PrincipalFrame(const ObjectModel& object) {
+// Centroid and principal axes (columns by increasing extent, right-handed) of
+// the object's surface sample. Not global_uniqueness.hpp's ModelPrincipalFrame
+// (decreasing extent): the learned sets depend on the order of the deliberate
+// views, and with that order one independent face-on box view was accepted by
+// a learned set (indicators_test) -- a fragility of the set learning, recorded
+// in docs/method.md.
+std::pair<Eigen::Vector3d, Eigen::Matrix3d> SurfacePrincipalAxes(const ObjectModel& object) {
   const PointSet& sample = object.sample();
   const Eigen::Vector3d centroid = sample.rowwise().mean();
   const PointSet centred = sample.colwise() - centroid;
@@ -166,7 +171,7 @@ std::vector<DeliberateView> DeliberateViews(const ObjectModel& object, const Del
     kept->push_back(d);
     views.push_back({kind, d, -1});
   };
-  const Eigen::Matrix3d axes = PrincipalFrame(object).second;
+  const Eigen::Matrix3d axes = SurfacePrincipalAxes(object).second;
   std::vector<Eigen::Vector3d> faces;
   for (int k = 0; k < 3; ++k) {
     for (double sign : {1.0, -1.0}) add(ViewKind::kFaceOn, sign * axes.col(k), &faces);
@@ -300,7 +305,7 @@ void DegeneracyOptions::Check() const {
 }
 
 std::vector<Pose> DegeneracySearchMotions(const ObjectModel& object) {
-  const auto [centroid, axes] = PrincipalFrame(object);   // principal frame, columns
+  const auto [centroid, axes] = SurfacePrincipalAxes(object);   // principal frame, columns
 
   std::vector<Pose> motions;
   for (const Eigen::Matrix3d& m : CubeGroup()) {   // the identity comes first

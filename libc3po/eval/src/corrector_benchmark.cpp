@@ -15,6 +15,7 @@
 #include "c3po/base/random.hpp"
 #include "c3po/eval/metrics.hpp"
 #include "c3po/geometry/registration.hpp"
+#include "c3po/method/pipeline.hpp"
 #include "c3po/synth/stray_points.hpp"
 #include "c3po/synth/synth.hpp"
 
@@ -79,7 +80,18 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
   out.corrector_ms = MillisecondsSince(start);
   out.corrector_cpu_ms = ThreadCpuMilliseconds() - cpu_start;
   const auto certify_start = std::chrono::steady_clock::now();
-  const Certificate certificate = ok ? Certify(object, cloud, pose, keypoints, options.certificate) : Certificate{};
+  PoseEstimate estimate;   // the whole certificate, with the global rival search (pipeline.hpp)
+  if (ok) {
+    estimate.scene_from_model = pose;
+    estimate.keypoints = keypoints;
+    estimate.certificate = Certify(object, cloud, pose, keypoints, options.certificate);
+    PipelineOptions pipeline;
+    pipeline.corrector = options.corrector;
+    if (solver) pipeline.corrector.solver = *solver;
+    pipeline.certificate = options.certificate;
+    CompleteCertificate(object, cloud, pipeline, nullptr, &estimate);
+  }
+  const Certificate& certificate = estimate.certificate;
   out.oc = ok && certificate.oc.passed;
   out.certified = ok && certificate.certified();
   out.nd_local = ok && certificate.nd.local.passed;

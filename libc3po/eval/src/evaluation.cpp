@@ -12,6 +12,7 @@
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/certify_batch.hpp"
 #include "c3po/method/keypoint_ransac.hpp"
+#include "c3po/method/pipeline.hpp"
 
 namespace c3po {
 namespace {
@@ -106,8 +107,13 @@ SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
   SampleResult sample = registration;
   sample.scene_from_model = icp.scene_from_model;
   sample.keypoints = icp.scene_from_model * object.keypoints();
-  const Certificate certificate = Certify(object, cloud, sample.scene_from_model, sample.keypoints,
-                                          options.pipeline.certificate);
+  PoseEstimate refined;   // the whole certificate, with the global rival search (pipeline.hpp)
+  refined.scene_from_model = sample.scene_from_model;
+  refined.keypoints = sample.keypoints;
+  refined.certificate = Certify(object, cloud, sample.scene_from_model, sample.keypoints,
+                                options.pipeline.certificate);
+  CompleteCertificate(object, cloud, options.pipeline, nullptr, &refined);
+  const Certificate& certificate = refined.certificate;
   sample.oc = certificate.oc.passed;
   sample.nd = certificate.nd.passed;
   sample.oc_distance = certificate.oc.max_point_distance;

@@ -86,6 +86,8 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
                                " but the mask is " + std::to_string(mask.width) + " x " + std::to_string(mask.height));
   }
   SegmentCloud result;
+  result.depth = std::make_shared<const DepthImage>(depth);
+  result.camera = camera;
   const Mask eroded = ErodeMask(mask, options.erode_mask);
   std::vector<Eigen::Vector3d> kept;
   std::vector<std::int32_t> kept_pixels;

@@ -65,6 +65,8 @@ void CertificateOptions::Check() const {
   if (!(std::isfinite(delta_nd) && delta_nd > 0)) throw std::invalid_argument("delta_nd must be > 0");
   max_outliers.Check();
   local.Check();
+  global.Check();
+  free_space.Check();
 }
 
 CertificateOptions CertificateOptions::FromObject(const ObjectSpec& spec) {

@@ -36,9 +36,17 @@ AutoEpsOcResult DecideAutoEpsOc(const ObjectModel& object, const std::vector<Poi
   decided.eps_oc = chosen.eps_oc;
   // Only estimates that have a pose have oc evidence: a failed registration
   // keeps oc = 0 (its distances were never computed) and records eps_oc.
+  PipelineOptions pipeline = options.pipeline;
+  pipeline.certificate = decided;
   const auto decide = [&](const PointSet& cloud, PoseEstimate* estimate) {
     if (estimate->ok()) {
+      // The free-space evidence does not depend on eps_oc beyond its tolerance
+      // (decided with the options' eps_oc) and the frame is released: kept.
+      // Rivals are searched again without the free-space filter (stricter).
+      const FreeSpace free_space = estimate->certificate.free_space;
       estimate->certificate = Certify(object, cloud, estimate->scene_from_model, estimate->keypoints, decided);
+      estimate->certificate.free_space = free_space;
+      CompleteCertificate(object, cloud, pipeline, nullptr, estimate);
     } else {
       estimate->certificate.oc.eps_oc = chosen.eps_oc;
     }
@@ -106,11 +114,16 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
   return sources;
 }
 
-PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts) {
+PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts, DepthView* frame) {
   if (!source.load_segment) return source.load();
   SegmentCloud segment = source.load_segment();
   PointSet cloud = std::move(segment.cloud);
   segment.cloud.resize(3, 0);   // the counts stay for the output
+  if (frame != nullptr) {
+    frame->depth = segment.depth;
+    frame->camera = segment.camera;
+  }
+  segment.depth.reset();        // the counts never keep the image alive (~1 MB per instance)
   if (segment_counts != nullptr) *segment_counts = segment;
   if (cloud.cols() < kMinSegmentPoints) {
     segment.cloud = cloud;
@@ -149,8 +162,9 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
     CloudOutcome& outcome = result.outcomes[i];
     const auto start = std::chrono::steady_clock::now();
     PointSet cloud;
+    DepthView view;   // image inputs: the frame, for the free-space test
     try {
-      cloud = LoadSourceCloud(source, &outcome.segment);
+      cloud = LoadSourceCloud(source, &outcome.segment, &view);
     } catch (const Interrupted&) {
       throw;
     } catch (const std::exception& e) {
@@ -172,10 +186,22 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
       }
     }
     if (outcome.processed()) {
-      if (options.also_uncorrected) {
-        outcome.uncorrected = EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected);
+      std::optional<FreeSpaceTest> free_space;
+      if (view.valid() && options.pipeline.certificate.free_space.enabled) {
+        free_space.emplace(object, view, options.pipeline.certificate.free_space, options.pipeline.certificate.eps_oc);
       }
-      outcome.estimate = EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline);
+      const FreeSpaceTest* free_space_test = free_space ? &*free_space : nullptr;
+      if (options.also_uncorrected) {
+        outcome.uncorrected =
+            EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected, free_space_test);
+      }
+      outcome.estimate =
+          EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline, free_space_test);
+      if (source.scene_from_model_truth && outcome.estimate.ok()) {
+        outcome.truth_hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000),
+                                                      *source.scene_from_model_truth,
+                                                      outcome.estimate.scene_from_model);
+      }
       outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (visit) visit(static_cast<std::size_t>(i), cloud, &outcome);
       if (options.auto_eps_oc) clouds[i] = std::move(cloud);

@@ -43,6 +43,7 @@ nlohmann::ordered_json SourceKeys(const CloudSource& source, const CloudOutcome&
     line["gt_R"] = RotationJson(G.R);
     line["gt_t"] = {G.t(0), G.t(1), G.t(2)};
   }
+  if (outcome.truth_hausdorff) line["gt_hausdorff"] = FiniteOrNull(*outcome.truth_hausdorff);
   return line;
 }
 
@@ -84,6 +85,25 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["nd_local_motion"] = {nd.local.motion(0), nd.local.motion(1), nd.local.motion(2),
                              nd.local.motion(3), nd.local.motion(4), nd.local.motion(5)};
   line["nd_local_rank"] = nd.local.model_rank;
+  // Global rival search (global_uniqueness.hpp); null when not run.
+  const GlobalUniqueness& g = nd.global;
+  line["nd_global"] = nd.global_checked ? nlohmann::ordered_json(g.passed) : nlohmann::ordered_json(nullptr);
+  line["rivals_tried"] = g.rivals_tried;
+  line["rivals_found"] = g.rivals_found;
+  line["rival_distance"] = g.rival_distance;
+  line["rival_hausdorff"] = g.rival_axis >= 0 ? nlohmann::ordered_json(g.rival_hausdorff) : nlohmann::ordered_json(nullptr);
+  line["rival_outliers"] = g.rival_outliers;
+  line["rival_axis"] = g.rival_axis;
+  line["rival_angle_deg"] = g.rival_angle_deg;
+  line["rival_passes_oc"] = g.rival_passes_oc;
+  line["rival_free_space_violations"] = g.rival_free_space_violations;
+  // Free space (depth-image inputs, free_space.hpp); null when not checked.
+  const FreeSpace& f = e.certificate.free_space;
+  line["free_space"] = f.checked ? nlohmann::ordered_json(f.passed) : nlohmann::ordered_json(nullptr);
+  line["free_space_violations"] = f.violations;
+  line["free_space_measured"] = f.measured;
+  line["free_space_silhouette"] = f.silhouette;
+  line["free_space_tolerance"] = f.tolerance;
   line["ms"] = e.milliseconds;
 }
 

@@ -13,8 +13,23 @@ void PipelineOptions::Check() const {
   certificate.Check();
 }
 
+void CompleteCertificate(const ObjectModel& object, const PointSet& cloud, const PipelineOptions& options,
+                         const FreeSpaceTest* free_space, PoseEstimate* estimate) {
+  Certificate& certificate = estimate->certificate;
+  certificate.nd.global_checked = false;
+  certificate.nd.global = GlobalUniqueness{};
+  if (!estimate->ok()) return;
+  if (free_space) certificate.free_space = free_space->Check(estimate->scene_from_model);
+  if (options.certificate.global.enabled && certificate.certified()) {
+    certificate.nd.global = CheckGlobalUniqueness(object, cloud, *estimate, options, free_space);
+    certificate.nd.global_checked = true;
+    certificate.nd.passed = certificate.nd.passed && certificate.nd.global.passed;
+  }
+}
+
 PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud,
-                                const PointSet& detected_keypoints, const PipelineOptions& options) {
+                                const PointSet& detected_keypoints, const PipelineOptions& options,
+                                const FreeSpaceTest* free_space) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
   PoseEstimate estimate;
@@ -44,6 +59,7 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
   if (estimate.ok()) {
     estimate.certificate = Certify(object, cloud, estimate.scene_from_model, estimate.keypoints,
                                    options.certificate);
+    CompleteCertificate(object, cloud, options, free_space, &estimate);
   } else {
     estimate.certificate.oc.eps_oc = options.certificate.eps_oc;
     estimate.certificate.nd.delta_nd = options.certificate.delta_nd;

@@ -13,6 +13,7 @@
 // removed_by_erosion + removed_by_discontinuity + removed_by_subsampling +
 // cloud.cols().
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,10 @@ struct SegmentCloud {
   std::size_t removed_by_erosion = 0;      // with depth, removed by step 2
   std::size_t removed_by_discontinuity = 0;
   std::size_t removed_by_subsampling = 0;
+  // The frame it came from (the free-space test renders the posed model into
+  // it, method/free_space.hpp); shared, released by the batch after use.
+  std::shared_ptr<const DepthImage> depth;
+  PinholeCamera camera;
 };
 
 // Back-projects the mask's pixels. Throws InputError("name: ...") when depth

@@ -6,12 +6,18 @@
 //         the corrected keypoints agree, as today); the others are "accepted";
 //   nd_m: the local non-degeneracy test passes on the accepted points and, if
 //         the object has indicator sets, some set has every posed keypoint
-//         supported by more than m accepted points within delta_nd.
-// m = 0 is the paper (eq. 19, eq. 21) plus the local test.
+//         supported by more than m accepted points within delta_nd, and no
+//         rival pose far from T̂ passes oc_m (the global search,
+//         global_uniqueness.hpp; run by the pipeline, EstimateAndCertify);
+//   free space (depth-image inputs only, free_space.hpp): the camera did not
+//         see through where the posed model would be.
+// m = 0 is the paper (eq. 19, eq. 21) plus the local and global tests.
 #include <string>
 #include <vector>
 
 #include "c3po/base/types.hpp"
+#include "c3po/method/free_space.hpp"
+#include "c3po/method/global_uniqueness.hpp"
 #include "c3po/method/local_nondegeneracy.hpp"
 #include "c3po/object/object_model.hpp"
 
@@ -30,8 +36,10 @@ struct OutlierBudget {
 // "10" | "2%" | "0"; throws InputError("--max-outliers", ...) otherwise.
 OutlierBudget ParseOutlierBudget(const std::string& text);
 
-// Default budget for depth-image / BOP input (segments with stray pixels;
-// measured, docs/method.md). Ready-made clouds default to 0.
+// Default budget for depth-image / BOP input of `c3po certify` (segments with
+// stray pixels; wired after 0 false certificates at it with the global rival
+// search and the free-space test on: docs/method.md "Measured on real
+// frames"). Ready-made clouds default to 0.
 constexpr double kDepthImageOutlierFraction = 0.02;
 
 struct CertificateOptions {
@@ -42,6 +50,8 @@ struct CertificateOptions {
   OutlierBudget max_outliers;                  // m
   bool local_nondegeneracy = true;             // the local test is part of nd
   LocalNonDegeneracyOptions local;
+  GlobalUniquenessOptions global;              // the rival search (pipeline.hpp runs it)
+  FreeSpaceOptions free_space;                 // depth-image inputs (pipeline.hpp runs it)
   void Check() const;      // both thresholds positive and finite
   static CertificateOptions FromObject(const ObjectSpec& spec);
 };
@@ -81,12 +91,17 @@ struct NonDegeneracy {
   std::vector<int> keypoint_support;      // per keypoint: supporting points within delta_nd
   bool local_checked = false;
   LocalNonDegeneracy local;               // evidence of the local test
+  // The global rival search (global_uniqueness.hpp): run by EstimateAndCertify
+  // when everything else passed (it cannot change any other decision).
+  bool global_checked = false;
+  GlobalUniqueness global;
 };
 
 struct Certificate {
   ObservableCorrectness oc;
   NonDegeneracy nd;
-  bool certified() const { return oc.passed && nd.passed; }
+  FreeSpace free_space;    // checked only for depth-image inputs (free_space.checked)
+  bool certified() const { return oc.passed && nd.passed && (!free_space.checked || free_space.passed); }
 };
 
 ObservableCorrectness CheckObservableCorrectness(const ObjectModel& object, const PointSet& cloud,

@@ -60,9 +60,12 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
 
 // Reads one source's cloud as CertifyBatch does: `load`, or `load_segment`
 // (image inputs) whose preprocessing counts go to `segment_counts` (when not
-// null) before a segment too small to use is refused. Throws InputError
-// naming the source (unreadable file, empty or too small segment).
-PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts = nullptr);
+// null; without the depth image) before a segment too small to use is
+// refused; `frame` (when not null) receives the segment's depth image and
+// camera for the free-space test (free_space.hpp). Throws InputError naming
+// the source (unreadable file, empty or too small segment).
+PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts = nullptr,
+                         DepthView* frame = nullptr);
 
 struct CertifyBatchOptions {
   PipelineOptions pipeline;           // corrector + certificate thresholds (absolute)
@@ -88,6 +91,9 @@ struct CloudOutcome {
   // Image inputs: the preprocessing counts (segment.hpp; `cloud` emptied),
   // also when the segment was too small to use (failure kLoad).
   std::optional<SegmentCloud> segment;
+  // Hausdorff(T*·B̂, T̂·B̂) when the source has a ground-truth pose (the
+  // correctness measure of docs/method.md: symmetries cost nothing).
+  std::optional<double> truth_hausdorff;
   double seconds = 0.0;               // reading + preprocessing + detection + estimate
   bool processed() const { return failure == Failure::kNone; }
   bool certified() const { return processed() && estimate.certified(); }
@@ -127,7 +133,16 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   max_inlier_distance, keypoint_support (per keypoint), nd_set_support (per
 //   set), nd_sets, nd_local (null when the local test is off),
 //   nd_local_eigenvalue, nd_local_motion (6: rotation, translation),
-//   nd_local_rank; and last ms.
+//   nd_local_rank; the global rival search (global_uniqueness.hpp): nd_global
+//   (null when not run: something else failed, or --no-global-check),
+//   rivals_tried, rivals_found, rival_distance, rival_hausdorff (null: no
+//   distinct rival), rival_outliers, rival_axis, rival_angle_deg,
+//   rival_passes_oc, rival_free_space_violations (-1: not checked); free space
+//   (free_space.hpp; depth-image inputs): free_space (null when not checked),
+//   free_space_violations, free_space_measured, free_space_silhouette,
+//   free_space_tolerance; and last ms. Image-source lines also carry
+//   gt_hausdorff after gt_t (Hausdorff(T*·B̂, T̂·B̂), metres) when the
+//   ground truth is known.
 constexpr std::size_t kMaxListedOutliers = 100;
 std::string CertifyJsonLine(const std::string& cloud, const PoseEstimate& estimate);
 // {"cloud": ..., "error": ...} for a cloud that could not be processed.

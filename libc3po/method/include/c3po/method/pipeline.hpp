@@ -3,6 +3,7 @@
 // keypoints -> registration (eq. 8) -> corrector (eq. 17) -> certificates.
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"
+#include "c3po/method/free_space.hpp"
 #include "c3po/object/object_model.hpp"
 
 namespace c3po {
@@ -29,7 +30,18 @@ struct PoseEstimate {
   bool certified() const { return ok() && certificate.certified(); }
 };
 
+// `free_space`: the depth frame's free-space test (image inputs), else nullptr.
 PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud,
-                                const PointSet& detected_keypoints, const PipelineOptions& options);
+                                const PointSet& detected_keypoints, const PipelineOptions& options,
+                                const FreeSpaceTest* free_space = nullptr);
+
+// The parts of the certificate that need more than the pose and the cloud's
+// distances (EstimateAndCertify calls it after Certify; callers that decide a
+// certificate again, e.g. --eps-oc auto, call it after their Certify):
+//  - free space (depth-image inputs: `free_space` not null);
+//  - the global rival search (options.certificate.global.enabled), run only
+//    when everything else passed (it can only turn nd off): nd.global.
+void CompleteCertificate(const ObjectModel& object, const PointSet& cloud, const PipelineOptions& options,
+                         const FreeSpaceTest* free_space, PoseEstimate* estimate);
 
 }  // namespace c3po

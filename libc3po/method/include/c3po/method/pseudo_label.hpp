@@ -9,11 +9,13 @@
 //
 // Rule: from the certified pose T̂ the corrector is restarted at the three
 // half-turns T̂·F_a (F_a = rotation by pi about principal axis a of B̂,
-// through its centroid). A rival fit whose corrected keypoints differ from
+// through its centroid; RefineRivals, global_uniqueness.hpp, the one home of
+// the rival restarts). A rival fit whose corrected keypoints differ from
 // y* by more than eps_oc is a second basin; the sample is ambiguous when a
 // second basin passes the oc certificate itself, or fits with an RMS residual
 // (input points to posed model) within residual_ratio of the chosen one, or
 // fits better than it.
+#include "c3po/method/global_uniqueness.hpp"
 #include "c3po/method/pipeline.hpp"
 
 namespace c3po {
@@ -35,17 +37,6 @@ struct PseudoLabelCheck {
 
 // RMS distance of the cloud's points to the model sample posed by `pose`.
 double FitResidual(const ObjectModel& object, const PointSet& cloud, const Pose& scene_from_model);
-
-// Principal axes of the model sample (columns, decreasing extent) and its centroid.
-struct PrincipalFrame {
-  Eigen::Matrix3d axes;
-  Eigen::Vector3d centroid;
-};
-PrincipalFrame ModelPrincipalFrame(const ObjectModel& object);
-
-// The half-turn about principal axis `axis` through the centroid, as a
-// model_from_model pose.
-Pose HalfTurn(const PrincipalFrame& frame, int axis);
 
 // `estimate` must be ok(); with check_ambiguity false only `residual` is filled.
 PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,

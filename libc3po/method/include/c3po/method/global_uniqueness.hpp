@@ -1,0 +1,117 @@
+#pragma once
+// Global uniqueness: the search part of nd (issue 16, docs/method.md "Global
+// uniqueness (rival search)"). The local test (local_nondegeneracy.hpp) proves
+// that no *nearby* pose fits the accepted points; it cannot see a pose far
+// away that fits them as well (the mustard bottle turned ~180° about its
+// axis, a banana or marker flipped). From the estimate T̂ the corrector is
+// restarted at rival hypotheses T̂·R_a(θ) (R_a(θ) = rotation by θ about
+// principal axis a of B̂ through its centroid; θ = k·360°/steps, k = 1 ..
+// steps-1, so the half-turns are always among them) and each rival is
+// refined. A refined rival T' that
+//   - passes oc_m with the same ε_oc and budget m as T̂ (and, for depth-image
+//     inputs, the free-space test: free_space.hpp), and
+//   - whose posed model is farther than `rival_distance` from T̂·B̂
+//     (Hausdorff between the posed model samples: symmetries cost nothing)
+// is a second explanation of the data: the input is ambiguous and nd fails.
+// This is a search, not a proof: it refuses when it finds a rival; it cannot
+// show that no rival exists (docs/method.md states what it guarantees).
+#include <Eigen/Core>
+#include <vector>
+
+#include "c3po/base/types.hpp"
+#include "c3po/object/object_model.hpp"
+
+namespace c3po {
+
+struct PipelineOptions;
+struct PoseEstimate;
+
+struct GlobalUniquenessOptions {
+  bool enabled = true;
+  // Rotations by k·360°/steps about each principal axis, k = 1 .. steps-1
+  // (even: the half-turns are included). 4: 90°, 180°, 270° (9 rivals).
+  int steps = 4;
+  // A rival counts when Hausdorff(T̂·B̂, T'·B̂) > rival_distance; 0 = 2·eps_oc.
+  // Two poses that both satisfy the guarantee lie within eps_oc + eps_w of
+  // the truth, hence within 2(eps_oc + eps_w) of each other: a rival beyond
+  // that proves one of them wrong. eps_w is unknown; 2·eps_oc <= 2(eps_oc +
+  // eps_w) refuses at least every such rival (docs/method.md).
+  double rival_distance = 0.0;
+  // Rivals are judged with a looser oc than the estimate: at most m +
+  // rival_extra_fraction·n points beyond eps_oc (n = cloud size). The
+  // estimate must beat every far pose by more than a few noisy points can
+  // explain (measured: a large marker whose true, flipped pose had 3 points
+  // beyond eps_oc while the wrong one had none). 0 = exactly oc_m.
+  double rival_extra_fraction = 0.01;
+  void Check() const;   // steps even and in [2, 36], rival_distance >= 0 finite, fraction in [0, 1)
+};
+
+// The evidence (part of NonDegeneracy, certificate.hpp).
+struct GlobalUniqueness {
+  bool passed = true;
+  double rival_distance = 0.0;  // the threshold used (object units)
+  int rivals_tried = 0;
+  int rivals_found = 0;         // distinct rivals passing the rivals' oc (and free space)
+  // The rival reported: the farthest one that counts; if none counts, the
+  // distinct one (farther than rival_distance) with the fewest outliers;
+  // axis -1 when every rival fell back within rival_distance of T̂.
+  int rival_axis = -1;          // principal axis (0 = largest extent)
+  double rival_angle_deg = 0.0; // start rotation about it
+  double rival_hausdorff = 0.0; // Hausdorff(T̂·B̂, T'·B̂)
+  int rival_outliers = -1;      // its oc_m outlier count (points >= eps_oc)
+  double rival_budget_distance = 0.0;   // its (m+1)-th largest point distance
+  bool rival_passes_oc = false;
+  int rival_free_space_violations = -1; // depth-image inputs: its free-space evidence (-1: not checked)
+  Pose rival_scene_from_model;
+};
+
+// Principal axes of the model sample (columns, decreasing extent, right-handed) and its centroid.
+struct PrincipalFrame {
+  Eigen::Matrix3d axes;
+  Eigen::Vector3d centroid;
+};
+PrincipalFrame ModelPrincipalFrame(const ObjectModel& object);
+
+// The rotation by `angle` (radians) about principal axis `axis` through the
+// centroid, as a model_from_model pose.
+Pose AxisRotation(const PrincipalFrame& frame, int axis, double angle);
+// AxisRotation(frame, axis, pi).
+Pose HalfTurn(const PrincipalFrame& frame, int axis);
+
+// One refined rival hypothesis.
+struct RivalFit {
+  int axis = -1;
+  double angle = 0.0;             // radians
+  bool ok = false;                // the corrector returned a pose
+  Pose scene_from_model;
+  PointSet keypoints;             // corrected keypoints of the rival
+  bool passes_oc = false;         // oc with the estimate's eps_oc and budget m (+ the rival slack, see above)
+  int outliers = 0;
+  double budget_distance = 0.0;
+  double keypoint_distance = 0.0; // max_i ||y*_i - y'_i||
+  double hausdorff = 0.0;         // Hausdorff(T̂·B̂, T'·B̂)
+};
+
+// Restarts the corrector (the pipeline's, with its robust kernel; certificates
+// without the global test) from T̂·R_a(θ) for every (axis, angle) given, on
+// `cloud`; the rivals' oc is decided with pipeline.certificate.
+std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                   const PipelineOptions& pipeline, const PrincipalFrame& frame,
+                                   const std::vector<std::pair<int, double>>& hypotheses);
+
+// The (axis, angle) hypotheses of the options (3 × (steps - 1)).
+std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOptions& options);
+
+// An extra test a rival must pass to count (the free-space test of depth-image
+// inputs, free_space.hpp): whether the pose passes and its violation count.
+struct RivalFilter {
+  virtual ~RivalFilter() = default;
+  virtual bool Passes(const Pose& scene_from_model, int* violations) const = 0;
+};
+
+// The global test of `estimate` (which must be ok()) on `cloud` with the
+// pipeline's corrector and certificate options.
+GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                       const PipelineOptions& pipeline, const RivalFilter* filter = nullptr);
+
+}  // namespace c3po

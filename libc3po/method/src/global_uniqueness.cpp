@@ -1,0 +1,146 @@
+// Global uniqueness: the rival search of nd (global_uniqueness.hpp).
+#include "c3po/method/global_uniqueness.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <stdexcept>
+#include <tuple>
+
+#include "c3po/geometry/registration.hpp"
+#include "c3po/method/pipeline.hpp"
+
+namespace c3po {
+
+void GlobalUniquenessOptions::Check() const {
+  if (steps < 2 || steps > 36 || steps % 2 != 0) {
+    throw std::invalid_argument("global uniqueness steps must be even and in [2, 36]");
+  }
+  if (!(rival_distance >= 0.0 && std::isfinite(rival_distance))) {
+    throw std::invalid_argument("global uniqueness rival distance must be >= 0");
+  }
+  if (!(rival_extra_fraction >= 0.0 && rival_extra_fraction < 1.0)) {
+    throw std::invalid_argument("global uniqueness rival slack must be in [0, 1)");
+  }
+}
+
+PrincipalFrame ModelPrincipalFrame(const ObjectModel& object) {
+  const PointSet& sample = object.sample();
+  PrincipalFrame frame;
+  frame.centroid = sample.rowwise().mean();
+  const PointSet centred = sample.colwise() - frame.centroid;
+  const Eigen::Matrix3d covariance = centred * centred.transpose() / std::max<double>(1.0, sample.cols());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  // Eigen sorts eigenvalues increasingly; axis 0 = largest extent.
+  for (int a = 0; a < 3; ++a) frame.axes.col(a) = solver.eigenvectors().col(2 - a);
+  if (frame.axes.determinant() < 0) frame.axes.col(2) = -frame.axes.col(2);   // right-handed
+  return frame;
+}
+
+Pose AxisRotation(const PrincipalFrame& frame, int axis, double angle) {
+  const Eigen::Vector3d u = frame.axes.col(axis).normalized();
+  Pose turn;
+  turn.R = Eigen::AngleAxisd(angle, u).toRotationMatrix();
+  turn.t = frame.centroid - turn.R * frame.centroid;
+  return turn;
+}
+
+Pose HalfTurn(const PrincipalFrame& frame, int axis) {
+  const Eigen::Vector3d u = frame.axes.col(axis).normalized();
+  // Rotation by pi about u: 2 u u^T - I (exact).
+  Pose flip;
+  flip.R = 2.0 * u * u.transpose() - Eigen::Matrix3d::Identity();
+  flip.t = frame.centroid - flip.R * frame.centroid;
+  return flip;
+}
+
+std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOptions& options) {
+  options.Check();
+  std::vector<std::pair<int, double>> hypotheses;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int k = 1; k < options.steps; ++k) hypotheses.emplace_back(axis, 2.0 * M_PI * k / options.steps);
+  }
+  return hypotheses;
+}
+
+std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                   const PipelineOptions& pipeline, const PrincipalFrame& frame,
+                                   const std::vector<std::pair<int, double>>& hypotheses) {
+  PipelineOptions rival_options = pipeline;
+  rival_options.correct = true;   // a rival is where the corrector settles from the turned start
+  rival_options.certificate.global.enabled = false;
+  rival_options.certificate.local_nondegeneracy = false;   // only the rival's oc is needed
+  // The rivals' budget: m + the slack (global_uniqueness.hpp).
+  const int m = pipeline.certificate.max_outliers.Resolve(cloud.cols());
+  rival_options.certificate.max_outliers = OutlierBudget{};
+  rival_options.certificate.max_outliers.count =
+      m + static_cast<int>(std::floor(pipeline.certificate.global.rival_extra_fraction * cloud.cols()));
+  const PointSet queries = StridedColumns(object.sample(), 1000);
+  std::vector<RivalFit> fits;
+  fits.reserve(hypotheses.size());
+  for (const auto& [axis, angle] : hypotheses) {
+    RivalFit fit;
+    fit.axis = axis;
+    fit.angle = angle;
+    const Pose turn = std::abs(angle - M_PI) < 1e-12 ? HalfTurn(frame, axis) : AxisRotation(frame, axis, angle);
+    const Pose start = estimate.scene_from_model * turn;
+    const PoseEstimate rival = EstimateAndCertify(object, cloud, start * object.keypoints(), rival_options);
+    fit.ok = rival.ok();
+    if (fit.ok) {
+      fit.scene_from_model = rival.scene_from_model;
+      fit.keypoints = rival.keypoints;
+      fit.passes_oc = rival.certificate.oc.passed;
+      fit.outliers = rival.certificate.oc.outlier_count;
+      fit.budget_distance = rival.certificate.oc.budget_distance;
+      fit.keypoint_distance = (rival.keypoints - estimate.keypoints).colwise().norm().maxCoeff();
+      fit.hausdorff = PosedModelHausdorff(object, queries, estimate.scene_from_model, rival.scene_from_model);
+    }
+    fits.push_back(std::move(fit));
+  }
+  return fits;
+}
+
+GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                       const PipelineOptions& pipeline, const RivalFilter* filter) {
+  const GlobalUniquenessOptions& options = pipeline.certificate.global;
+  GlobalUniqueness global;
+  global.rival_distance = options.rival_distance > 0.0 ? options.rival_distance : 2.0 * pipeline.certificate.eps_oc;
+  if (!estimate.ok()) {
+    global.passed = false;
+    return global;
+  }
+  const std::vector<RivalFit> fits =
+      RefineRivals(object, cloud, estimate, pipeline, ModelPrincipalFrame(object), RivalHypotheses(options));
+  global.rivals_tried = static_cast<int>(fits.size());
+  // The reported rival: counting ones first (the farthest), then the
+  // distinct one with the fewest outliers, then the smallest budget distance.
+  auto key = [](bool counts, const RivalFit& f) {
+    return counts ? std::make_tuple(false, -f.hausdorff, 0.0) : std::make_tuple(true, double(f.outliers), f.budget_distance);
+  };
+  bool have_best = false;
+  std::tuple<bool, double, double> best_key;
+  for (const RivalFit& fit : fits) {
+    if (!fit.ok || !(fit.hausdorff > global.rival_distance)) continue;   // failed, or T̂'s own basin
+    int violations = -1;
+    bool free_space_ok = true;
+    if (fit.passes_oc && filter) free_space_ok = filter->Passes(fit.scene_from_model, &violations);
+    const bool counts = fit.passes_oc && free_space_ok;
+    if (counts) ++global.rivals_found;
+    const auto fit_key = key(counts, fit);
+    if (!have_best || fit_key < best_key) {
+      have_best = true;
+      best_key = fit_key;
+      global.rival_axis = fit.axis;
+      global.rival_angle_deg = fit.angle * 180.0 / M_PI;
+      global.rival_hausdorff = fit.hausdorff;
+      global.rival_outliers = fit.outliers;
+      global.rival_budget_distance = fit.budget_distance;
+      global.rival_passes_oc = fit.passes_oc;
+      global.rival_free_space_violations = violations;
+      global.rival_scene_from_model = fit.scene_from_model;
+    }
+  }
+  global.passed = global.rivals_found == 0;
+  return global;
+}
+
+}  // namespace c3po

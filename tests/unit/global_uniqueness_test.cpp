@@ -1,0 +1,239 @@
+// Global uniqueness (rival search) and free space (issue 16; docs/method.md
+// "Global uniqueness" and "Free space"). Oracles: planted two-fold
+// ambiguities whose rival is known by construction, and rendered depth frames
+// where the true pose is consistent with the observed free space by
+// construction and a shifted pose is not.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "c3po/base/random.hpp"
+#include "c3po/geometry/render.hpp"
+#include "c3po/method/free_space.hpp"
+#include "c3po/method/global_uniqueness.hpp"
+#include "c3po/method/pipeline.hpp"
+#include "test_objects.hpp"
+
+using namespace c3po;
+
+namespace {
+
+// A 0.20 x 0.10 x 0.06 box with a 0.04-cube bump on one end of the top face:
+// two-fold symmetric (half-turn about z) except for the bump.
+Mesh BumpedBoxMesh() { return test::MergeMeshes({test::BoxMesh({0, 0, 0}, {0.20, 0.10, 0.06}),
+                                                 test::BoxMesh({0.07, 0.0, 0.05}, {0.04, 0.04, 0.04})}); }
+
+ObjectModel BumpedBox() {
+  ObjectSpec spec;
+  spec.name = "bumped_box";
+  spec.keypoints.resize(3, 9);
+  spec.keypoints << -0.10, 0.10, 0.10, -0.10, -0.10, 0.10, 0.10, -0.10, 0.07,  //
+      -0.05, -0.05, 0.05, 0.05, -0.05, -0.05, 0.05, 0.05, 0.0,                 //
+      -0.03, -0.03, -0.03, -0.03, 0.03, 0.03, 0.03, 0.03, 0.07;
+  spec.eps_oc = 0.01;   // above the sample spacing of B̂ (~2 mm) with margin
+  spec.delta_nd = 0.008;
+  ObjectModelOptions options;
+  options.sample_size = 20000;
+  return ObjectModel(spec, BumpedBoxMesh(), options);
+}
+
+Pose TestPose() {
+  Pose pose;
+  pose.R = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  pose.t = {0.02, -0.01, 0.8};
+  return pose;
+}
+
+PipelineOptions Options(const ObjectModel& object) {
+  PipelineOptions options;
+  options.certificate = CertificateOptions::FromObject(object.spec());
+  return options;
+}
+
+// Points on the box part only (the bump's footprint on the top face removed):
+// every one of them also lies on the model turned by pi about z.
+PointSet BoxOnlyCloud(int count, std::uint64_t seed) {
+  const PointSet box = SampleSurface(test::BoxMesh({0, 0, 0}, {0.20, 0.10, 0.06}), count, seed);
+  PointSet kept(3, box.cols());
+  Eigen::Index n = 0;
+  for (Eigen::Index j = 0; j < box.cols(); ++j) {
+    const Eigen::Vector3d p = box.col(j);
+    const bool under_bump = p.z() > 0.029 && std::abs(p.x() - 0.07) < 0.021 && std::abs(p.y()) < 0.021;
+    const bool under_mirror = p.z() > 0.029 && std::abs(p.x() + 0.07) < 0.021 && std::abs(p.y()) < 0.021;
+    if (!under_bump && !under_mirror) kept.col(n++) = p;
+  }
+  return kept.leftCols(n);
+}
+
+}  // namespace
+
+TEST_CASE("global uniqueness: hypotheses and axis rotations") {
+  GlobalUniquenessOptions options;
+  CHECK(RivalHypotheses(options).size() == 9);
+  options.steps = 6;
+  CHECK(RivalHypotheses(options).size() == 15);
+  options.steps = 3;
+  CHECK_THROWS(options.Check());
+  const ObjectModel object = BumpedBox();
+  const PrincipalFrame frame = ModelPrincipalFrame(object);
+  for (int axis = 0; axis < 3; ++axis) {
+    // AxisRotation(pi) is the exact half-turn; rotations fix the centroid.
+    const Pose a = AxisRotation(frame, axis, M_PI), b = HalfTurn(frame, axis);
+    CHECK((a.R - b.R).norm() < 1e-12);
+    CHECK((a * frame.centroid - frame.centroid).norm() < 1e-12);
+    const Pose quarter = AxisRotation(frame, axis, M_PI / 2);
+    CHECK(((quarter * quarter).R - b.R).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("global uniqueness: a planted two-fold rival is refused; the discriminating part is certified") {
+  const ObjectModel object = BumpedBox();
+  const Pose truth = TestPose();
+  const PipelineOptions options = Options(object);
+
+  // Only the symmetric box: the bump may be at either end.
+  const PointSet ambiguous = truth * BoxOnlyCloud(3000, 3);
+  const PoseEstimate at_truth = EstimateAndCertify(object, ambiguous, truth * object.keypoints(), options);
+  REQUIRE(at_truth.ok());
+  CHECK(at_truth.certificate.oc.passed);
+  CHECK(at_truth.certificate.nd.local.passed);    // locally well constrained: the local test cannot see it
+  REQUIRE(at_truth.certificate.nd.global_checked);
+  CHECK_FALSE(at_truth.certificate.nd.global.passed);
+  CHECK_FALSE(at_truth.certified());
+  CHECK(at_truth.certificate.nd.global.rivals_found >= 1);
+  CHECK(at_truth.certificate.nd.global.rival_passes_oc);
+  // The rival is the half-turn: the bump (0.04 above the top face) moved to
+  // the other end, so its top is ~0.04 from the rival's surface.
+  CHECK(at_truth.certificate.nd.global.rival_hausdorff > 0.035);
+  CHECK(at_truth.certificate.nd.global.rival_hausdorff < 0.06);
+  CHECK(at_truth.certificate.nd.global.rival_outliers == 0);
+
+  // Switched off, the same estimate is certified (what the test adds).
+  PipelineOptions off = options;
+  off.certificate.global.enabled = false;
+  const PoseEstimate unchecked = EstimateAndCertify(object, ambiguous, truth * object.keypoints(), off);
+  CHECK(unchecked.certified());
+  CHECK_FALSE(unchecked.certificate.nd.global_checked);
+
+  // With the bump's points the rival leaves them in the air: certified.
+  const PointSet bump = truth * SampleSurface(test::BoxMesh({0.07, 0.0, 0.05}, {0.04, 0.04, 0.04}), 400, 4);
+  PointSet discriminating(3, ambiguous.cols() + bump.cols());
+  discriminating << ambiguous, bump;
+  const PointSet& cloud = discriminating;
+  const PoseEstimate good = EstimateAndCertify(object, cloud, truth * object.keypoints(), options);
+  REQUIRE(good.ok());
+  CHECK(good.certificate.nd.global_checked);
+  CHECK(good.certificate.nd.global.passed);
+  CHECK(good.certified());
+  CHECK(good.certificate.nd.global.rivals_tried == 9);
+}
+
+TEST_CASE("global uniqueness: a symmetric object's turns are not rivals") {
+  // A plain box: every half-turn about a principal axis maps it onto itself,
+  // so the refined rivals coincide with the estimate as shapes (Hausdorff ~ 0).
+  ObjectSpec spec;
+  spec.name = "box";
+  spec.keypoints = test::BoxMesh({0, 0, 0}, {0.20, 0.10, 0.06}).vertices;
+  spec.eps_oc = 0.01;
+  spec.delta_nd = 0.008;
+  ObjectModelOptions model_options;
+  model_options.sample_size = 20000;
+  const ObjectModel box(spec, test::BoxMesh({0, 0, 0}, {0.20, 0.10, 0.06}), model_options);
+  const Pose truth = TestPose();
+  const PointSet cloud = truth * SampleSurface(box.mesh(), 3000, 5);
+  const PoseEstimate e = EstimateAndCertify(box, cloud, truth * box.keypoints(), Options(box));
+  REQUIRE(e.ok());
+  CHECK(e.certificate.nd.global_checked);
+  CHECK(e.certificate.nd.global.passed);
+  CHECK(e.certified());
+}
+
+namespace {
+
+// A depth frame of the bumped box in front of a wall (the background) at the
+// true pose, rendered by the same renderer the test uses.
+struct Frame {
+  DepthView view;
+  Pose truth;
+};
+
+Frame RenderFrame(const ObjectModel& object) {
+  Frame frame;
+  frame.truth = TestPose();
+  CameraIntrinsics camera;
+  DepthRenderer renderer(camera);
+  renderer.Render(object.mesh(), frame.truth);
+  auto depth = std::make_shared<DepthImage>();
+  depth->width = camera.width;
+  depth->height = camera.height;
+  depth->z.assign(static_cast<std::size_t>(camera.width) * camera.height, 1.5f);   // a wall at 1.5 m
+  for (const int pixel : renderer.covered_pixels()) {
+    depth->z[static_cast<std::size_t>(pixel)] = static_cast<float>(renderer.BackProject(pixel).z());
+  }
+  frame.view.depth = depth;
+  frame.view.camera = camera;
+  return frame;
+}
+
+}  // namespace
+
+TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the background fails") {
+  const ObjectModel object = BumpedBox();
+  const Frame frame = RenderFrame(object);
+  FreeSpaceOptions options;
+  const FreeSpaceTest test(object, frame.view, options, object.spec().eps_oc);
+  const FreeSpace at_truth = test.Check(frame.truth);
+  CHECK(at_truth.checked);
+  CHECK(at_truth.passed);
+  CHECK(at_truth.silhouette > 1000);
+  CHECK(at_truth.measured == at_truth.silhouette);
+  CHECK(at_truth.violations == 0);
+
+  // Shifted sideways by 10 cm: most of its silhouette lies over the wall.
+  Pose shifted = frame.truth;
+  shifted.t.x() += 0.10;
+  const FreeSpace off = test.Check(shifted);
+  CHECK_FALSE(off.passed);
+  CHECK(off.violations > 0.3 * off.measured);
+
+  // Turned by 90 deg about the camera axis: the long box now covers wall.
+  Pose turned = frame.truth;
+  turned.R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix() * frame.truth.R;
+  turned.t = frame.truth.t;
+  CHECK_FALSE(test.Check(turned).passed);
+
+  // An occluder in front of the object (a bar at 0.5 m across the middle of
+  // the image) hides part of it: consistent with free space at the truth.
+  auto occluded = std::make_shared<DepthImage>(*frame.view.depth);
+  for (int v = 200; v < 280; ++v) {
+    for (int u = 0; u < occluded->width; ++u) occluded->z[static_cast<std::size_t>(v) * occluded->width + u] = 0.5f;
+  }
+  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera}, options, object.spec().eps_oc);
+  const FreeSpace behind_occluder = with_occluder.Check(frame.truth);
+  CHECK(behind_occluder.passed);
+  CHECK(behind_occluder.violations == 0);
+  // Moved 5 cm towards the camera, the model would hide the surface the
+  // camera saw behind it: a violation everywhere outside the occluder.
+  Pose closer = frame.truth;
+  closer.t.z() -= 0.05;
+  CHECK_FALSE(test.Check(closer).passed);
+
+  // Missing depth is unknown, not a violation.
+  auto holes = std::make_shared<DepthImage>(*frame.view.depth);
+  std::fill(holes->z.begin(), holes->z.end(), 0.0f);
+  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera}, options, object.spec().eps_oc);
+  const FreeSpace unknown = blind.Check(shifted);
+  CHECK(unknown.passed);
+  CHECK(unknown.measured == 0);
+
+  // Through the pipeline: the shifted pose's cloud-free certificate fails on
+  // free space even though the given cloud (the object's points shifted) fits it.
+  const PointSet cloud = shifted * SampleSurface(object.mesh(), 2000, 9);
+  const PoseEstimate e = EstimateAndCertify(object, cloud, shifted * object.keypoints(), Options(object), &test);
+  REQUIRE(e.ok());
+  CHECK(e.certificate.oc.passed);
+  CHECK(e.certificate.free_space.checked);
+  CHECK_FALSE(e.certificate.free_space.passed);
+  CHECK_FALSE(e.certified());
+}
