@@ -42,6 +42,15 @@ int main(int argc, char** argv) {
                 certificate.oc.passed ? "yes" : "no", certificate.oc.max_point_distance, certificate.oc.eps_oc);
     std::printf("  non-degeneracy:         %s (indicator set %d, delta_nd %.6g)\n",
                 certificate.nd.passed ? "yes" : "no", certificate.nd.passing_set, certificate.nd.delta_nd);
+    if (certificate.nd.local_checked) {
+      std::printf("    local test:           %s (smallest generalised eigenvalue %.3g)\n",
+                  certificate.nd.local.passed ? "yes" : "no", certificate.nd.local.min_eigenvalue);
+    }
+    if (certificate.nd.global_checked) {
+      std::printf("    no far rival:         %s (%d of %d turned starts fit as well)\n",
+                  certificate.nd.global.passed ? "yes" : "no", certificate.nd.global.rivals_found,
+                  certificate.nd.global.rivals_tried);
+    }
     std::printf("  scene_from_model t = [%.5f %.5f %.5f]\n", pose.t(0), pose.t(1), pose.t(2));
     for (int row = 0; row < 3; ++row) {
       std::printf("  %s [%.5f %.5f %.5f]\n", row == 0 ? "R =" : "   ", pose.R(row, 0), pose.R(row, 1),
