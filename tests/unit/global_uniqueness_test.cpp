@@ -237,3 +237,39 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   CHECK_FALSE(e.certificate.free_space.passed);
   CHECK_FALSE(e.certified());
 }
+
+TEST_CASE("global uniqueness: the rival slack has a floor in points (few discriminating points on a small cloud)") {
+  const ObjectModel object = BumpedBox();
+  const Pose truth = TestPose();
+  const PipelineOptions options = Options(object);
+  // A small cloud of the symmetric box plus 6 points on the bump's top face
+  // (z = 0.07): 0.04 above the half-turned model's box top, so the half-turn
+  // rival has exactly these 6 points beyond eps_oc = 0.01 and explains the rest.
+  const PointSet box = BoxOnlyCloud(300, 5);
+  PointSet cloud(3, box.cols() + 6);
+  cloud.leftCols(box.cols()) = box;
+  const double offsets[6][2] = {{-0.01, -0.01}, {0.0, -0.01}, {0.01, -0.01}, {-0.01, 0.01}, {0.0, 0.01}, {0.01, 0.01}};
+  for (int i = 0; i < 6; ++i) cloud.col(box.cols() + i) = Eigen::Vector3d(0.07 + offsets[i][0], offsets[i][1], 0.07);
+  cloud = truth * cloud;
+  REQUIRE(static_cast<int>(std::floor(0.01 * cloud.cols())) < 6);   // the fraction alone forgives fewer than 6
+
+  // Fraction only (the floor off): the rival has 6 > floor(1 % n) outliers and
+  // does not count, so the estimate is certified although the 6 points are all
+  // that tells the poses apart.
+  PipelineOptions fraction_only = options;
+  fraction_only.certificate.global.rival_extra_min = 0;
+  const PoseEstimate loose = EstimateAndCertify(object, cloud, truth * object.keypoints(), fraction_only);
+  REQUIRE(loose.ok());
+  REQUIRE(loose.certificate.oc.passed);
+  CHECK(loose.certificate.nd.global.passed);
+
+  // Default (floor 10 points): the rival counts and the input is ambiguous.
+  const PoseEstimate guarded = EstimateAndCertify(object, cloud, truth * object.keypoints(), options);
+  REQUIRE(guarded.ok());
+  CHECK(options.certificate.global.RivalSlack(cloud.cols()) == 10);
+  CHECK_FALSE(guarded.certificate.nd.global.passed);
+  CHECK_FALSE(guarded.certified());
+  CHECK(guarded.certificate.nd.global.rival_outliers >= 1);
+  CHECK(guarded.certificate.nd.global.rival_outliers <= 10);
+  CHECK(guarded.certificate.nd.global.rival_hausdorff > 0.035);
+}

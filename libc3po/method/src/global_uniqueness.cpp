@@ -2,6 +2,7 @@
 #include "c3po/method/global_uniqueness.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <tuple>
@@ -21,6 +22,11 @@ void GlobalUniquenessOptions::Check() const {
   if (!(rival_extra_fraction >= 0.0 && rival_extra_fraction < 1.0)) {
     throw std::invalid_argument("global uniqueness rival slack must be in [0, 1)");
   }
+  if (rival_extra_min < 0) throw std::invalid_argument("global uniqueness rival slack floor must be >= 0");
+}
+
+int GlobalUniquenessOptions::RivalSlack(Eigen::Index n) const {
+  return std::max(static_cast<int>(std::floor(rival_extra_fraction * static_cast<double>(n))), rival_extra_min);
 }
 
 PrincipalFrame ModelPrincipalFrame(const ObjectModel& object) {
@@ -72,8 +78,7 @@ std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cl
   // The rivals' budget: m + the slack (global_uniqueness.hpp).
   const int m = pipeline.certificate.max_outliers.Resolve(cloud.cols());
   rival_options.certificate.max_outliers = OutlierBudget{};
-  rival_options.certificate.max_outliers.count =
-      m + static_cast<int>(std::floor(pipeline.certificate.global.rival_extra_fraction * cloud.cols()));
+  rival_options.certificate.max_outliers.count = m + pipeline.certificate.global.RivalSlack(cloud.cols());
   const PointSet queries = StridedColumns(object.sample(), 1000);
   std::vector<RivalFit> fits;
   fits.reserve(hypotheses.size());

@@ -29,6 +29,7 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
   // below is its own margin).
   PipelineOptions exact = pipeline;
   exact.certificate.global.rival_extra_fraction = 0.0;
+  exact.certificate.global.rival_extra_min = 0;
   for (const RivalFit& rival : RefineRivals(object, cloud, estimate, exact, frame, half_turns)) {
     if (!rival.ok) continue;
     if (rival.keypoint_distance <= eps_oc) continue;   // the same basin

@@ -38,12 +38,18 @@ struct GlobalUniquenessOptions {
   // eps_w) refuses at least every such rival (docs/method.md).
   double rival_distance = 0.0;
   // Rivals are judged with a looser oc than the estimate: at most m +
-  // rival_extra_fraction·n points beyond eps_oc (n = cloud size). The
-  // estimate must beat every far pose by more than a few noisy points can
-  // explain (measured: a large marker whose true, flipped pose had 3 points
-  // beyond eps_oc while the wrong one had none). 0 = exactly oc_m.
+  // max(floor(rival_extra_fraction·n), rival_extra_min) points beyond eps_oc
+  // (n = cloud size). The estimate must beat every far pose by more than a
+  // few noisy points can explain (measured: a large marker whose true,
+  // flipped pose had 3 points beyond eps_oc while the wrong one had none; and
+  // with --robust-loss tls at m = 0 one whose true pose had 8 on a 775-point
+  // segment, one more than 1 % -- hence the floor in points). Both 0 =
+  // exactly oc_m.
   double rival_extra_fraction = 0.01;
-  void Check() const;   // steps even and in [2, 36], rival_distance >= 0 finite, fraction in [0, 1)
+  int rival_extra_min = 10;
+  // The slack in points for a cloud of n points.
+  int RivalSlack(Eigen::Index n) const;
+  void Check() const;   // steps even and in [2, 36], rival_distance >= 0 finite, fraction in [0, 1), min >= 0
 };
 
 // The evidence (part of NonDegeneracy, certificate.hpp).
