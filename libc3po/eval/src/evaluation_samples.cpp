@@ -5,6 +5,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "c3po/base/lines.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/base/json.hpp"
 #include "c3po/io/shard.hpp"
@@ -211,12 +212,9 @@ struct Part {
 
 Part ReadPart(const std::string& name, const std::string& text) {
   Part part;
-  std::size_t start = 0, line_number = 0;
-  while (start < text.size()) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    const std::string line = text.substr(start, end - start);
-    start = end + 1;
+  std::size_t line_number = 0;
+  for (const std::string_view view : SplitLines(text)) {
+    const std::string line(view);
     ++line_number;
     const std::string where = name + ": line " + std::to_string(line_number);
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;

@@ -12,6 +12,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "c3po/base/lines.hpp"
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/base/json.hpp"
@@ -287,12 +288,9 @@ Dataset ReadDataset(const std::string& dir_argument, bool ground_truth) {
   dataset.dir = dir;
   // The keypoint count of each object label ("" = unlabelled lines) and the line that set it.
   std::map<std::string, std::pair<std::size_t, std::size_t>> keypoint_counts;
-  std::size_t line_number = 0, start = 0;
-  while (start < text.size()) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(start, end - start);
-    start = end + 1;
+  std::size_t line_number = 0;
+  for (const std::string_view view : SplitLines(text)) {
+    std::string line(view);
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos) continue;

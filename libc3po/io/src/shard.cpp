@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "c3po/base/lines.hpp"
 #include "c3po/base/error.hpp"
 
 namespace c3po {
@@ -56,12 +57,9 @@ Dataset ShardDataset(const Dataset& dataset, const Shard& shard) {
 std::string MergeShardOutputs(const std::vector<std::pair<std::string, std::string>>& parts, bool csv) {
   std::string merged, header;
   for (const auto& [name, text] : parts) {
-    std::size_t start = 0, line_number = 0;
-    while (start < text.size()) {
-      std::size_t end = text.find('\n', start);
-      if (end == std::string::npos) end = text.size();
-      const std::string line = text.substr(start, end - start);
-      start = end + 1;
+    std::size_t line_number = 0;
+    for (const std::string_view view : SplitLines(text)) {
+      const std::string line(view);
       ++line_number;
       if (csv && line_number == 1) {
         if (line.rfind("scene_id,im_id,obj_id,score,R,t,time", 0) != 0) throw InputError(name, "line 1: not a BOP results CSV header");
