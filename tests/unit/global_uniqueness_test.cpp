@@ -273,3 +273,113 @@ TEST_CASE("global uniqueness: the rival slack has a floor in points (few discrim
   CHECK(guarded.certificate.nd.global.rival_outliers <= 10);
   CHECK(guarded.certificate.nd.global.rival_hausdorff > 0.035);
 }
+
+namespace {
+
+// A 0.20 x 0.12 x 0.06 box (keypoints: its corners).
+ObjectModel PlainBox() {
+  ObjectSpec spec;
+  spec.name = "box";
+  spec.keypoints = test::BoxMesh({0, 0, 0}, {0.20, 0.12, 0.06}).vertices;
+  spec.eps_oc = 0.01;
+  spec.delta_nd = 0.008;
+  ObjectModelOptions model_options;
+  model_options.sample_size = 20000;
+  return ObjectModel(spec, test::BoxMesh({0, 0, 0}, {0.20, 0.12, 0.06}), model_options);
+}
+
+// Points on the top (z = 0.03) and front (y = 0.06) faces with |x| <= half_length:
+// the faces share the edge along x, so the local test sees one weak motion
+// (sliding along x); with half_length = 0.10 the faces are whole.
+PointSet TwoFaces(double half_length, std::uint64_t seed) {
+  const PointSet surface = SampleSurface(test::BoxMesh({0, 0, 0}, {0.20, 0.12, 0.06}), 12000, seed);
+  PointSet kept(3, surface.cols());
+  Eigen::Index n = 0;
+  for (Eigen::Index j = 0; j < surface.cols(); ++j) {
+    const Eigen::Vector3d p = surface.col(j);
+    const bool on_face = std::abs(p.z() - 0.03) < 1e-9 || std::abs(p.y() - 0.06) < 1e-9;
+    if (on_face && std::abs(p.x()) <= half_length) kept.col(n++) = p;
+  }
+  return kept.leftCols(n);
+}
+
+}  // namespace
+
+TEST_CASE("weak motion: the displacement moves surface points by J(p)^T xi to first order") {
+  const ObjectModel box = PlainBox();
+  const Eigen::Vector3d centre = box.sample().rowwise().mean();
+  const double radius = 0.5 * box.diameter();
+  Eigen::Matrix<double, 6, 1> xi;
+  xi << 0.3, -0.5, 0.2, 0.4, 0.1, -0.67;
+  xi.normalize();
+  const double s = 1e-5;
+  const Pose displacement = WeakMotionDisplacement(box, xi, s);
+  for (Eigen::Index i = 0; i < box.sample().cols(); i += 997) {
+    const Eigen::Vector3d p = box.sample().col(i), n = box.sample_normals().col(i);
+    Eigen::Matrix<double, 6, 1> J;   // the header's J(p) = ((p - c) x n / r, n), computed here
+    J << (p - centre).cross(n) / radius, n;
+    CHECK(std::abs((displacement * p - p).dot(n) / s - J.dot(xi)) < 1e-4);
+  }
+}
+
+TEST_CASE("weak motion: a box seen on two whole faces is certified, the faces' middle part is refused") {
+  const ObjectModel box = PlainBox();
+  const Pose truth = TestPose();
+  PipelineOptions options = Options(box);
+  options.correct = false;   // certify the true pose itself
+
+  const PointSet whole = truth * TwoFaces(0.10, 7);
+  const PoseEstimate e = EstimateAndCertify(box, whole, truth * box.keypoints(), options);
+  REQUIRE(e.ok());
+  CHECK(e.certificate.oc.passed);
+  // To first order the faces slide along their common edge ...
+  CHECK_FALSE(e.certificate.nd.local.passed);
+  CHECK(e.certificate.nd.local.weak_motions == 1);
+  CHECK(std::abs(e.certificate.nd.local.motion(3)) > 0.9);   // mostly a translation along x
+  // ... finitely they leave the faces' ends in the air: no rival, certified.
+  REQUIRE(e.certificate.nd.weak_motion_checked);
+  CHECK(e.certificate.nd.weak_motion.passed);
+  CHECK(e.certificate.nd.weak_motion.starts >= 4);
+  CHECK(e.certificate.nd.weak_motion.rivals_found == 0);
+  CHECK(e.certified());
+
+  // Switched off, the single weak motion fails nd as before.
+  PipelineOptions off = options;
+  off.certificate.local.weak_motion_check = false;
+  const PoseEstimate strict = EstimateAndCertify(box, whole, truth * box.keypoints(), off);
+  CHECK_FALSE(strict.certificate.nd.weak_motion_checked);
+  CHECK_FALSE(strict.certified());
+
+  // Only |x| <= 4 cm of the 10 cm half-length: the slid pose explains every
+  // point, so the pose is not determined and the check finds the rival.
+  const PointSet middle = truth * TwoFaces(0.04, 7);
+  const PoseEstimate m = EstimateAndCertify(box, middle, truth * box.keypoints(), options);
+  REQUIRE(m.ok());
+  CHECK(m.certificate.oc.passed);
+  CHECK(m.certificate.nd.local.weak_motions == 1);
+  REQUIRE(m.certificate.nd.weak_motion_checked);
+  CHECK_FALSE(m.certificate.nd.weak_motion.passed);
+  CHECK(m.certificate.nd.weak_motion.rivals_found >= 1);
+  CHECK(m.certificate.nd.weak_motion.rival_hausdorff > 2 * box.spec().eps_oc);
+  CHECK_FALSE(m.certified());
+}
+
+TEST_CASE("weak motion: a single face (three weak motions) is never discharged") {
+  const ObjectModel box = PlainBox();
+  const Pose truth = TestPose();
+  PipelineOptions options = Options(box);
+  options.correct = false;
+  const PointSet surface = SampleSurface(box.mesh(), 12000, 9);
+  std::vector<Eigen::Index> top;
+  for (Eigen::Index j = 0; j < surface.cols(); ++j) {
+    if (std::abs(surface(2, j) - 0.03) < 1e-9) top.push_back(j);
+  }
+  PointSet face(3, static_cast<Eigen::Index>(top.size()));
+  for (std::size_t k = 0; k < top.size(); ++k) face.col(static_cast<Eigen::Index>(k)) = surface.col(top[k]);
+  const PoseEstimate e = EstimateAndCertify(box, truth * face, truth * box.keypoints(), options);
+  REQUIRE(e.ok());
+  CHECK(e.certificate.oc.passed);
+  CHECK(e.certificate.nd.local.weak_motions >= 3);
+  CHECK_FALSE(e.certificate.nd.weak_motion_checked);
+  CHECK_FALSE(e.certified());
+}

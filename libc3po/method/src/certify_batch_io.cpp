@@ -85,6 +85,15 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["nd_local_motion"] = {nd.local.motion(0), nd.local.motion(1), nd.local.motion(2),
                              nd.local.motion(3), nd.local.motion(4), nd.local.motion(5)};
   line["nd_local_rank"] = nd.local.model_rank;
+  line["nd_local_weak_motions"] = nd.local.weak_motions;
+  // The finite check of a single weak motion (global_uniqueness.hpp); null when not run.
+  const WeakMotionCheck& w = nd.weak_motion;
+  line["nd_weak_motion"] = nd.weak_motion_checked ? nlohmann::ordered_json(w.passed) : nlohmann::ordered_json(nullptr);
+  line["weak_motion_starts"] = w.starts;
+  line["weak_motion_rivals"] = w.rivals_found;
+  line["weak_motion_rival_step"] = w.rivals_found > 0 ? nlohmann::ordered_json(w.rival_step) : nlohmann::ordered_json(nullptr);
+  line["weak_motion_rival_hausdorff"] =
+      w.rivals_found > 0 ? nlohmann::ordered_json(w.rival_hausdorff) : nlohmann::ordered_json(nullptr);
   // Global rival search (global_uniqueness.hpp); null when not run.
   const GlobalUniqueness& g = nd.global;
   line["nd_global"] = nd.global_checked ? nlohmann::ordered_json(g.passed) : nlohmann::ordered_json(nullptr);

@@ -68,11 +68,10 @@ std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOption
   return hypotheses;
 }
 
-std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
-                                   const PipelineOptions& pipeline, const PrincipalFrame& frame,
-                                   const std::vector<std::pair<int, double>>& hypotheses) {
+std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                const PipelineOptions& pipeline, const std::vector<RivalStart>& starts, bool refine) {
   PipelineOptions rival_options = pipeline;
-  rival_options.correct = true;   // a rival is where the corrector settles from the turned start
+  rival_options.correct = refine;   // a refined rival is where the corrector settles from the start
   rival_options.certificate.global.enabled = false;
   rival_options.certificate.local_nondegeneracy = false;   // only the rival's oc is needed
   // The rivals' budget: m + the slack (global_uniqueness.hpp).
@@ -81,14 +80,13 @@ std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cl
   rival_options.certificate.max_outliers.count = m + pipeline.certificate.global.RivalSlack(cloud.cols());
   const PointSet queries = StridedColumns(object.sample(), 1000);
   std::vector<RivalFit> fits;
-  fits.reserve(hypotheses.size());
-  for (const auto& [axis, angle] : hypotheses) {
+  fits.reserve(starts.size());
+  for (const RivalStart& start : starts) {
     RivalFit fit;
-    fit.axis = axis;
-    fit.angle = angle;
-    const Pose turn = std::abs(angle - M_PI) < 1e-12 ? HalfTurn(frame, axis) : AxisRotation(frame, axis, angle);
-    const Pose start = estimate.scene_from_model * turn;
-    const PoseEstimate rival = EstimateAndCertify(object, cloud, start * object.keypoints(), rival_options);
+    fit.axis = start.axis;
+    fit.angle = start.angle;
+    const PoseEstimate rival =
+        EstimateAndCertify(object, cloud, start.scene_from_model * object.keypoints(), rival_options);
     fit.ok = rival.ok();
     if (fit.ok) {
       fit.scene_from_model = rival.scene_from_model;
@@ -102,6 +100,79 @@ std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cl
     fits.push_back(std::move(fit));
   }
   return fits;
+}
+
+std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                   const PipelineOptions& pipeline, const PrincipalFrame& frame,
+                                   const std::vector<std::pair<int, double>>& hypotheses) {
+  std::vector<RivalStart> starts;
+  starts.reserve(hypotheses.size());
+  for (const auto& [axis, angle] : hypotheses) {
+    const Pose turn = std::abs(angle - M_PI) < 1e-12 ? HalfTurn(frame, axis) : AxisRotation(frame, axis, angle);
+    starts.push_back({axis, angle, estimate.scene_from_model * turn});
+  }
+  return FitRivals(object, cloud, estimate, pipeline, starts, true);
+}
+
+namespace {
+
+// A rival counts when it was fitted, lies beyond the distance, passes the
+// rivals' oc and (depth-image inputs) the free-space test.
+bool RivalCounts(const RivalFit& fit, double rival_distance, const RivalFilter* filter, int* violations) {
+  *violations = -1;
+  if (!fit.ok || !(fit.hausdorff > rival_distance) || !fit.passes_oc) return false;
+  return !filter || filter->Passes(fit.scene_from_model, violations);
+}
+
+}  // namespace
+
+Pose WeakMotionDisplacement(const ObjectModel& object, const Eigen::Matrix<double, 6, 1>& motion, double step) {
+  // The twist's frame (local_nondegeneracy.cpp): about the sample centroid c,
+  // rotation part scaled by r = d/2.
+  const Eigen::Vector3d centre = object.sample().rowwise().mean();
+  const double radius = std::max(0.5 * object.diameter(), 1e-12);
+  const Eigen::Vector3d rotation = step * motion.head<3>() / radius;
+  Pose displacement;
+  const double angle = rotation.norm();
+  displacement.R = angle > 0 ? Eigen::AngleAxisd(angle, rotation / angle).toRotationMatrix()
+                             : Eigen::Matrix3d::Identity();
+  displacement.t = centre + step * motion.tail<3>() - displacement.R * centre;
+  return displacement;
+}
+
+WeakMotionCheck CheckWeakMotion(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                const PipelineOptions& pipeline, const RivalFilter* filter) {
+  WeakMotionCheck check;
+  if (!estimate.ok()) return check;
+  const GlobalUniquenessOptions& global = pipeline.certificate.global;
+  const double rival_distance = global.rival_distance > 0.0 ? global.rival_distance : 2.0 * pipeline.certificate.eps_oc;
+  const Eigen::Matrix<double, 6, 1> motion = estimate.certificate.nd.local.motion;
+  std::vector<RivalStart> starts;
+  for (double step = 1.5 * rival_distance; step <= object.diameter() && step > 0; step *= 2.0) {
+    for (double sign : {1.0, -1.0}) {
+      starts.push_back({-1, sign * step, estimate.scene_from_model * WeakMotionDisplacement(object, motion, sign * step)});
+    }
+  }
+  for (bool refine : {false, true}) {
+    for (const RivalFit& fit : FitRivals(object, cloud, estimate, pipeline, starts, refine)) {
+      ++check.starts;
+      int violations = -1;
+      if (RivalCounts(fit, rival_distance, filter, &violations)) {
+        ++check.rivals_found;
+        if (fit.hausdorff > check.rival_hausdorff) {
+          check.rival_hausdorff = fit.hausdorff;
+          check.rival_step = fit.angle;
+          check.rival_outliers = fit.outliers;
+        }
+      } else if (fit.ok && fit.hausdorff > rival_distance &&
+                 (check.fewest_outliers < 0 || fit.outliers < check.fewest_outliers)) {
+        check.fewest_outliers = fit.outliers;
+        check.fewest_outliers_step = fit.angle;
+      }
+    }
+  }
+  check.passed = !starts.empty() && check.rivals_found == 0;
+  return check;
 }
 
 GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
@@ -126,9 +197,7 @@ GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet
   for (const RivalFit& fit : fits) {
     if (!fit.ok || !(fit.hausdorff > global.rival_distance)) continue;   // failed, or T̂'s own basin
     int violations = -1;
-    bool free_space_ok = true;
-    if (fit.passes_oc && filter) free_space_ok = filter->Passes(fit.scene_from_model, &violations);
-    const bool counts = fit.passes_oc && free_space_ok;
+    const bool counts = RivalCounts(fit, global.rival_distance, filter, &violations);
     if (counts) ++global.rivals_found;
     const auto fit_key = key(counts, fit);
     if (!have_best || fit_key < best_key) {

@@ -96,24 +96,33 @@ LocalNonDegeneracy CheckLocalNonDegeneracy(const ObjectModel& object, const Eige
   // Generalised eigenproblem H_data ξ = λ H_model ξ on the seen motions.
   const Eigen::MatrixXd A = W.transpose() * H_data * W;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> generalised(0.5 * (A + A.transpose()));
-  const Vector6 motion = W * generalised.eigenvectors().col(0);
-  result.motion = motion.normalized();
-  result.eigenvalue_all_points = std::max(0.0, generalised.eigenvalues()(0));
-  result.min_eigenvalue = result.eigenvalue_all_points;
-  if (max_outliers > 0) {
-    // m accepted points might be outliers placed to supply exactly the
-    // missing information: drop the m that contribute most along ξ_min.
+  // λ along one generalised eigenvector ξ: with m > 0, m accepted points
+  // might be outliers placed to supply exactly the missing information, so
+  // the m that contribute most along ξ are dropped first.
+  auto robust_value = [&](const Vector6& xi, double plain) {
+    if (max_outliers <= 0) return plain;
     std::vector<double> contribution;
     contribution.reserve(rows);
-    for_each_row([&](const Vector6& J) { contribution.push_back(std::pow(J.dot(motion), 2)); });
+    for_each_row([&](const Vector6& J) { contribution.push_back(std::pow(J.dot(xi), 2)); });
     const std::size_t drop = std::min<std::size_t>(max_outliers, contribution.size());
     std::nth_element(contribution.begin(), contribution.begin() + drop, contribution.end(), std::greater<double>());
     double kept = 0.0;
     for (std::size_t i = drop; i < contribution.size(); ++i) kept += contribution[i];
-    const double model_information = motion.dot(H_model * motion);
-    if (model_information > 0) {
-      result.min_eigenvalue = std::min(result.min_eigenvalue, kept / static_cast<double>(rows) / model_information);
+    const double model_information = xi.dot(H_model * xi);
+    return model_information > 0 ? std::min(plain, kept / static_cast<double>(rows) / model_information) : plain;
+  };
+  for (Eigen::Index k = 0; k < generalised.eigenvalues().size(); ++k) {
+    const Vector6 xi = W * generalised.eigenvectors().col(k);
+    const double plain = std::max(0.0, generalised.eigenvalues()(k));
+    const double value = robust_value(xi, plain);
+    if (k == 0) {
+      result.motion = xi.normalized();
+      result.eigenvalue_all_points = plain;
+      result.min_eigenvalue = value;
+    } else if (k == 1) {
+      result.second_eigenvalue = value;
     }
+    if (value < options.min_eigenvalue) ++result.weak_motions;
   }
   result.passed = result.observed_points >= options.min_points && result.min_eigenvalue >= options.min_eigenvalue;
   return result;

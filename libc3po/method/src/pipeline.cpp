@@ -13,13 +13,33 @@ void PipelineOptions::Check() const {
   certificate.Check();
 }
 
+namespace {
+
+// Only the local test failed, on a single weak motion, and it had the points
+// to decide (LocalNonDegeneracyOptions::weak_motion_check).
+bool WeakMotionCheckApplies(const Certificate& certificate, const CertificateOptions& options) {
+  const NonDegeneracy& nd = certificate.nd;
+  return options.local.weak_motion_check && certificate.oc.passed && nd.sets_passed && nd.local_checked &&
+         !nd.local.passed && nd.local.weak_motions == 1 && nd.local.observed_points >= options.local.min_points &&
+         (!certificate.free_space.checked || certificate.free_space.passed);
+}
+
+}  // namespace
+
 void CompleteCertificate(const ObjectModel& object, const PointSet& cloud, const PipelineOptions& options,
                          const FreeSpaceTest* free_space, PoseEstimate* estimate) {
   Certificate& certificate = estimate->certificate;
   certificate.nd.global_checked = false;
   certificate.nd.global = GlobalUniqueness{};
+  certificate.nd.weak_motion_checked = false;
+  certificate.nd.weak_motion = WeakMotionCheck{};
   if (!estimate->ok()) return;
   if (free_space) certificate.free_space = free_space->Check(estimate->scene_from_model);
+  if (WeakMotionCheckApplies(certificate, options.certificate)) {
+    certificate.nd.weak_motion = CheckWeakMotion(object, cloud, *estimate, options, free_space);
+    certificate.nd.weak_motion_checked = true;
+    certificate.nd.passed = certificate.nd.sets_passed && certificate.nd.weak_motion.passed;
+  }
   if (options.certificate.global.enabled && certificate.certified()) {
     certificate.nd.global = CheckGlobalUniqueness(object, cloud, *estimate, options, free_space);
     certificate.nd.global_checked = true;

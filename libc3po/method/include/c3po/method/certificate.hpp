@@ -91,6 +91,11 @@ struct NonDegeneracy {
   std::vector<int> keypoint_support;      // per keypoint: supporting points within delta_nd
   bool local_checked = false;
   LocalNonDegeneracy local;               // evidence of the local test
+  // The finite check of a single weak motion (global_uniqueness.hpp, run by
+  // EstimateAndCertify when the local test failed on exactly one motion and
+  // everything else passed): when it passes, nd's local part passes.
+  bool weak_motion_checked = false;
+  WeakMotionCheck weak_motion;
   // The global rival search (global_uniqueness.hpp): run by EstimateAndCertify
   // when everything else passed (it cannot change any other decision).
   bool global_checked = false;

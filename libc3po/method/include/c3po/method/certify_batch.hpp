@@ -133,7 +133,11 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   max_inlier_distance, keypoint_support (per keypoint), nd_set_support (per
 //   set), nd_sets, nd_local (null when the local test is off),
 //   nd_local_eigenvalue, nd_local_motion (6: rotation, translation),
-//   nd_local_rank; the global rival search (global_uniqueness.hpp): nd_global
+//   nd_local_rank, nd_local_weak_motions; the finite check of a single weak
+//   motion (global_uniqueness.hpp): nd_weak_motion (null when not run; true:
+//   nd's local part passes although nd_local is false), weak_motion_starts,
+//   weak_motion_rivals, weak_motion_rival_step and weak_motion_rival_hausdorff
+//   (null without a rival); the global rival search (global_uniqueness.hpp): nd_global
 //   (null when not run: something else failed, or --no-global-check),
 //   rivals_tried, rivals_found, rival_distance, rival_hausdorff (null: no
 //   distinct rival), rival_outliers, rival_axis, rival_angle_deg,

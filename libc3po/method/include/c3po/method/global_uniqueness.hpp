@@ -115,6 +115,48 @@ struct RivalFilter {
   virtual bool Passes(const Pose& scene_from_model, int* violations) const = 0;
 };
 
+// One rival start: the pose the fit starts from and how it was made.
+struct RivalStart {
+  int axis = -1;          // principal axis of a turn; -1 for a displacement along the weak motion
+  double angle = 0.0;     // turn (radians) or displacement step (object units)
+  Pose scene_from_model;
+};
+// Fits every start on `cloud` (the rivals' budget and options as in
+// RefineRivals); with refine = false the start itself is judged (no corrector).
+std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                const PipelineOptions& pipeline, const std::vector<RivalStart>& starts, bool refine);
+
+// The finite check of a single weak motion (local_nondegeneracy.hpp): the
+// first-order test refuses a box seen on two faces because sliding along
+// their common edge moves no observed point off its face *to first order*;
+// finitely it pushes the points past the faces' ends. From T̂ the pose is
+// displaced along the weak motion ξ (model frame, about the centroid:
+// rotation s·ω, translation s·v, ξ = (r ω, v) unit) by
+// s = ±1.5·rival_distance·2^k (k = 0, 1, ... while s <= the diameter); each
+// displaced pose is judged as it is and after refitting, as a rival of the
+// global search (passes the rivals' oc -- budget m + slack -- and free space,
+// and lies farther than rival_distance from T̂). No rival: the weak motion is
+// constrained finitely and nd's local part passes. Like the global search
+// this refuses on evidence and cannot prove absence between the steps
+// (docs/method.md "Weak motion").
+struct WeakMotionCheck {
+  bool passed = false;
+  int starts = 0;                 // displaced poses judged (raw and refitted)
+  int rivals_found = 0;
+  double rival_step = 0.0;        // the displacement s of the reported rival (object units)
+  double rival_hausdorff = 0.0;   // its Hausdorff distance to T̂·B̂ (0: none)
+  int rival_outliers = -1;        // its outlier count (-1: none)
+  double fewest_outliers_step = 0.0;  // without a rival: the distinct displacement that came closest
+  int fewest_outliers = -1;
+};
+
+// The displacement by s along the unit twist ξ (LocalNonDegeneracy::motion)
+// as a model_from_model pose.
+Pose WeakMotionDisplacement(const ObjectModel& object, const Eigen::Matrix<double, 6, 1>& motion, double step);
+
+WeakMotionCheck CheckWeakMotion(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
+                                const PipelineOptions& pipeline, const RivalFilter* filter = nullptr);
+
 // The global test of `estimate` (which must be ok()) on `cloud` with the
 // pipeline's corrector and certificate options.
 GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,

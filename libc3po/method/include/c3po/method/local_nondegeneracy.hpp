@@ -29,6 +29,11 @@ struct LocalNonDegeneracyOptions {
   double min_eigenvalue = kDefaultLocalNdMinEigenvalue;  // pass iff λ_min >= this
   double model_floor = 1e-3;   // motions with model information below floor × max are symmetries
   int min_points = 6;          // fewer accepted points: fails (6 unknowns)
+  // A single weak motion may be discharged by displacing the pose along it
+  // and refitting (global_uniqueness.hpp, CheckWeakMotion): the first-order
+  // test cannot see the outline of a face (a box seen on two faces slides
+  // along their edge to first order, not finitely).
+  bool weak_motion_check = true;
   void Check() const;          // throws std::invalid_argument
 };
 
@@ -39,6 +44,12 @@ struct LocalNonDegeneracy {
   Eigen::Matrix<double, 6, 1> motion = Eigen::Matrix<double, 6, 1>::Zero();  // unit (r ω, v), model frame
   int observed_points = 0;            // accepted points used
   int model_rank = 0;                 // motions the model sees (6 minus symmetries)
+  // Generalised eigenvectors (seen motions) whose λ (each after removing the
+  // m most informative points along it) is below min_eigenvalue; the
+  // pipeline may discharge a single one by a finite check
+  // (global_uniqueness.hpp, CheckWeakMotion).
+  int weak_motions = 0;
+  double second_eigenvalue = 0.0;     // the second smallest λ (same robust rule); 0 if rank < 2
 };
 
 // The model side (H_model, in the scaled twist coordinates above): depends on
