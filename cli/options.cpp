@@ -61,6 +61,9 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                      "point-to-plane information); 0 = local test off");
   command.add_flag("--no-global-check", flags->no_global_check,
                    "nd without the global rival search (restarts of the corrector at turned poses; on by default)");
+  command.add_flag("--reestimate", flags->reestimate,
+                   "When the estimate fails oc or free space, restart the corrector at the rival search's turns and "
+                   "certify the best fit that passes instead (off by default)");
   command.add_flag("--no-weak-motion-check", flags->no_weak_motion_check,
                    "A single motion the local test finds weak fails nd (by default the pose is displaced along it "
                    "and refitted: no second fit = constrained)");
@@ -87,6 +90,7 @@ void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, Co
   }
   certificate->global.enabled = !flags.no_global_check;
   certificate->local.weak_motion_check = !flags.no_weak_motion_check;
+  certificate->global.reestimate = flags.reestimate;
   certificate->global.steps = flags.global_steps;
   if (flags.global_steps < 2 || flags.global_steps > 36 || flags.global_steps % 2 != 0) {
     throw InputError("--global-steps", std::to_string(flags.global_steps) + " must be even and in [2, 36]");
@@ -128,6 +132,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (!flags.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + flags.nd_min_eigenvalue;
   if (flags.no_global_check) line += " --no-global-check";
   if (flags.no_weak_motion_check) line += " --no-weak-motion-check";
+  if (flags.reestimate) line += " --reestimate";
   if (flags.global_steps != 4) line += " --global-steps " + std::to_string(flags.global_steps);
   if (flags.no_free_space) line += " --no-free-space";
   if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;

@@ -58,6 +58,7 @@ struct RobustFlags {
   std::string robust_loss = "none";
   std::string nd_min_eigenvalue;   // "" = default; 0 = local test off
   bool no_global_check = false;    // --no-global-check: nd without the rival search
+  bool reestimate = false;         // --reestimate: restart a refuted estimate at the rival turns
   bool no_weak_motion_check = false;   // --no-weak-motion-check: a single weak motion fails nd
   int global_steps = 4;            // --global-steps
   bool no_free_space = false;      // --no-free-space (depth-image inputs)

@@ -383,3 +383,39 @@ TEST_CASE("weak motion: a single face (three weak motions) is never discharged")
   CHECK_FALSE(e.certificate.nd.weak_motion_checked);
   CHECK_FALSE(e.certified());
 }
+
+TEST_CASE("re-estimation: a flipped start is refuted, the restart at the half-turn is certified") {
+  const ObjectModel object = BumpedBox();
+  const Pose truth = TestPose();
+  // The whole box with its bump: the half-turn leaves the bump's points in the air.
+  const PointSet cloud = truth * SampleSurface(BumpedBoxMesh(), 4000, 11);
+  const PrincipalFrame frame = ModelPrincipalFrame(object);
+  // The detector's keypoints in the flipped basin: half-turned about the box's
+  // smallest axis (z), the turn that swaps the bump's end.
+  const PointSet flipped_keypoints = truth * HalfTurn(frame, 2) * object.keypoints();
+  PipelineOptions options = Options(object);
+  const PoseEstimate kept = EstimateAndCertify(object, cloud, flipped_keypoints, options);
+  REQUIRE(kept.ok());
+  CHECK_FALSE(kept.certificate.oc.passed);   // refuted by the bump's points
+  CHECK_FALSE(kept.certified());
+  CHECK(kept.restart_axis == -1);
+  CHECK(kept.restarts_tried == 0);
+
+  options.certificate.global.reestimate = true;
+  const PoseEstimate restarted = EstimateAndCertify(object, cloud, flipped_keypoints, options);
+  REQUIRE(restarted.ok());
+  CHECK(restarted.restarts_tried == 9);
+  CHECK(restarted.restart_axis >= 0);
+  CHECK(restarted.certified());
+  // Oracle: the truth (the box alone is two-fold symmetric, the bump is not).
+  const PointSet queries = StridedColumns(object.sample(), 1000);
+  CHECK(PosedModelHausdorff(object, queries, truth, restarted.scene_from_model) < object.spec().eps_oc);
+  // The detector's keypoints are reported as they were.
+  CHECK((restarted.detected_keypoints - flipped_keypoints).norm() < 1e-12);
+
+  // An estimate that is not refuted is never replaced.
+  const PoseEstimate good = EstimateAndCertify(object, cloud, truth * object.keypoints(), options);
+  CHECK(good.certified());
+  CHECK(good.restart_axis == -1);
+  CHECK(good.restarts_tried == 0);
+}

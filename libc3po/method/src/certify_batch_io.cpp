@@ -66,6 +66,10 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["cost_before"] = FiniteOrNull(e.correction.cost_before);
   line["cost_after"] = FiniteOrNull(e.correction.cost_after);
   line["status"] = ToString(e.correction.registration);
+  // Re-estimation (GlobalUniquenessOptions::reestimate): the turn whose restart replaced a refuted estimate.
+  line["restarts_tried"] = e.restarts_tried;
+  line["restart_axis"] = e.restart_axis;
+  line["restart_angle_deg"] = e.restart_angle_deg;
   // Outlier-robust evidence (docs/method.md "Outlier-robust certificates").
   const ObservableCorrectness& oc = e.certificate.oc;
   const NonDegeneracy& nd = e.certificate.nd;

@@ -73,6 +73,7 @@ std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud
   PipelineOptions rival_options = pipeline;
   rival_options.correct = refine;   // a refined rival is where the corrector settles from the start
   rival_options.certificate.global.enabled = false;
+  rival_options.certificate.global.reestimate = false;
   rival_options.certificate.local_nondegeneracy = false;   // only the rival's oc is needed
   // The rivals' budget: m + the slack (global_uniqueness.hpp).
   const int m = pipeline.certificate.max_outliers.Resolve(cloud.cols());

@@ -1,6 +1,8 @@
 #include "c3po/method/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 #include "c3po/geometry/registration.hpp"
@@ -47,6 +49,47 @@ void CompleteCertificate(const ObjectModel& object, const PointSet& cloud, const
   }
 }
 
+namespace {
+
+bool Refuted(const Certificate& certificate) {
+  return !certificate.oc.passed || (certificate.free_space.checked && !certificate.free_space.passed);
+}
+
+// GlobalUniquenessOptions::reestimate: the refuted estimate is replaced by the
+// best restart that passes oc_m and free space, if any.
+void Reestimate(const ObjectModel& object, const PointSet& cloud, const PipelineOptions& options,
+                const FreeSpaceTest* free_space, PoseEstimate* estimate) {
+  const PrincipalFrame frame = ModelPrincipalFrame(object);
+  const std::vector<std::pair<int, double>> hypotheses = RivalHypotheses(options.certificate.global);
+  const std::vector<RivalFit> fits = RefineRivals(object, cloud, *estimate, options, frame, hypotheses);
+  // Candidates by their outlier count (the rivals' looser budget), best first.
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < fits.size(); ++i) {
+    if (fits[i].ok && fits[i].passes_oc) order.push_back(i);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return fits[a].outliers < fits[b].outliers; });
+  PipelineOptions once = options;
+  once.certificate.global.reestimate = false;
+  for (const std::size_t i : order) {
+    int violations = -1;
+    if (free_space && !free_space->Passes(fits[i].scene_from_model, &violations)) continue;
+    const auto& [axis, angle] = hypotheses[i];
+    const Pose turn = std::abs(angle - M_PI) < 1e-12 ? HalfTurn(frame, axis) : AxisRotation(frame, axis, angle);
+    PoseEstimate restarted =
+        EstimateAndCertify(object, cloud, estimate->scene_from_model * turn * object.keypoints(), once, free_space);
+    if (!restarted.ok() || Refuted(restarted.certificate)) continue;
+    restarted.detected_keypoints = estimate->detected_keypoints;
+    restarted.restart_axis = axis;
+    restarted.restart_angle_deg = angle * 180.0 / M_PI;
+    *estimate = std::move(restarted);
+    break;
+  }
+  estimate->restarts_tried = static_cast<int>(hypotheses.size());
+}
+
+}  // namespace
+
 PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud,
                                 const PointSet& detected_keypoints, const PipelineOptions& options,
                                 const FreeSpaceTest* free_space) {
@@ -80,6 +123,9 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
     estimate.certificate = Certify(object, cloud, estimate.scene_from_model, estimate.keypoints,
                                    options.certificate);
     CompleteCertificate(object, cloud, options, free_space, &estimate);
+    if (options.correct && options.certificate.global.reestimate && Refuted(estimate.certificate)) {
+      Reestimate(object, cloud, options, free_space, &estimate);
+    }
   } else {
     estimate.certificate.oc.eps_oc = options.certificate.eps_oc;
     estimate.certificate.nd.delta_nd = options.certificate.delta_nd;

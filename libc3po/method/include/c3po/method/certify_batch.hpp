@@ -125,7 +125,9 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   cloud, R (3 rows), t, keypoints (N x 3, corrected), oc, nd, certified,
 //   oc_distance (null when not finite), keypoint_distance, nd_set,
 //   nd_set_distances, eps_oc, delta_nd, iterations, cost_before, cost_after
-//   (null when not finite), status (registration), then the outlier-robust
+//   (null when not finite), status (registration), restarts_tried,
+//   restart_axis and restart_angle_deg (re-estimation: axis -1 when the
+//   detector's estimate was kept; global_uniqueness.hpp), then the outlier-robust
 //   evidence (docs/method.md "Outlier-robust certificates"): max_outliers (m
 //   for this cloud), outliers (count at >= eps_oc), outlier_indices (the first
 //   kMaxListedOutliers, ascending), outlier_indices_truncated,
