@@ -241,6 +241,21 @@ void AddBopOptions(CLI::App& command, BopFlags* flags, BopDetections detections)
   }
 }
 
+void AddCameraCloudOptions(CLI::App& command, CameraCloudFlags* flags, const std::string& augment_prefix,
+                           const std::string& copies_help) {
+  flags->noise_flag = "--" + augment_prefix + "noise";
+  AddFrameOptions(command, &flags->frame);
+  AddBopOptions(command, &flags->bop, BopDetections::kRefused);
+  AddSegmentOptions(command, &flags->segment);
+  command.add_option("--copies", flags->augment.copies, copies_help);
+  command.add_option("--" + augment_prefix + "dropout", flags->augment.drop_fraction,
+                     "Augmentation: fraction of each copy's points dropped")
+      ->capture_default_str();
+  command.add_option(flags->noise_flag, flags->noise,
+                     "Augmentation: Gaussian noise sigma per coordinate of each copy (a distance: 1mm, 0.001, 0.5%d)")
+      ->capture_default_str();
+}
+
 void AddShardOption(CLI::App& command, std::string* shard, const std::string& what) {
   command.add_option("--shard", *shard, "Process part K of N (K/N, 1-based) of the " + what +
                                             ": disjoint, deterministic; join with c3po merge");

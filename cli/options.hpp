@@ -19,6 +19,7 @@
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"
 #include "c3po/method/detector.hpp"
+#include "c3po/method/selftrain_inputs.hpp"
 #include "c3po/object/object_model.hpp"
 
 namespace c3po::cli {
@@ -118,6 +119,25 @@ struct BopFlags {
 };
 enum class BopDetections { kRefused, kAllowed };
 void AddBopOptions(CLI::App& command, BopFlags* flags, BopDetections detections);
+
+// Camera inputs of the training commands (selftrain, train): one frame
+// (--depth/--mask/--camera) and/or BOP instances (--bop/--obj-id/--targets),
+// the segment preprocessing, and the paper's augmentation: --copies N per
+// real instance, each dropping a fraction of its points and adding noise
+// (selftrain_inputs.hpp AugmentOptions). The dropout/noise flags are named
+// <augment_prefix>dropout / <augment_prefix>noise: "" in selftrain, "copy-"
+// in train (whose --dropout/--noise are its per-epoch augmentation).
+struct CameraCloudFlags {
+  FrameFlags frame;
+  BopFlags bop;
+  SegmentOptions segment;
+  AugmentOptions augment;        // noise_sigma and seed are set when loading
+  std::string noise = "1mm";     // a distance: 1mm, 0.001, 0.5%d
+  std::string noise_flag = "--noise";   // its name (set by AddCameraCloudOptions)
+  bool given() const { return frame.given() || !bop.dir.empty(); }
+};
+void AddCameraCloudOptions(CLI::App& command, CameraCloudFlags* flags, const std::string& augment_prefix,
+                           const std::string& copies_help);
 
 // --shard K/N ("" = the whole run); ParseShard (c3po/io/shard.hpp) resolves it.
 void AddShardOption(CLI::App& command, std::string* shard, const std::string& what);

@@ -39,11 +39,7 @@ struct SelftrainCommand {
   RobustFlags robust;
   bool resume = false;
   // Camera inputs (docs/camera_inputs.md) and the paper's augmentation.
-  FrameFlags frame;
-  BopFlags bop;
-  SegmentOptions segment;
-  AugmentOptions augment;
-  std::string augment_noise = "1mm";
+  CameraCloudFlags camera;
 };
 
 // The unlabelled clouds: a dataset (as stored; augmented only with --copies
@@ -52,14 +48,7 @@ struct SelftrainCommand {
 // instances as read), each with its validation group (a dataset cloud, or
 // an image).
 UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
-  cmd.augment.noise_sigma = ParseThreshold(cmd.augment_noise, object.diameter(), "--noise");
-  cmd.augment.seed = cmd.options.seed;
-  try {
-    cmd.augment.Check();
-  } catch (const std::invalid_argument& e) {
-    throw InputError("c3po selftrain", e.what());
-  }
-  CheckSegmentOptions(cmd.segment, "c3po selftrain");
+  UnlabelledClouds camera = LoadCameraClouds(&cmd.camera, object, cmd.options.seed, "c3po selftrain");
   UnlabelledClouds data;
   if (!cmd.data_dir.empty()) {
     const Dataset dataset = ReadDataset(cmd.data_dir);
@@ -70,34 +59,12 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
       data.names.push_back(dataset.entries[i].cloud);
       data.labels.push_back(dataset.entries[i].object.value_or(""));
     }
-    if (cmd.augment.copies > 1) data = Augment(data, cmd.augment);
+    if (cmd.camera.augment.copies > 1) data = Augment(data, cmd.camera.augment);
   }
-  std::vector<CloudSource> sources;
-  if (cmd.frame.given()) {
-    for (auto& s : FrameSources(ResolveFrame(cmd.frame, "c3po selftrain"), cmd.segment)) sources.push_back(s);
-  }
-  if (!cmd.bop.dir.empty()) {
-    const BopInstances listed = ListBopInstances(cmd.bop.dir, cmd.bop.options);
-    if (listed.instances.empty()) {
-      throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id) +
-                                        (cmd.bop.options.targets_path.empty() ? "" : " among the targets"));
-    }
-    for (auto& s : BopSources(listed, cmd.segment)) sources.push_back(s);
-  }
-  if (cmd.data_dir.empty() && sources.empty()) {
+  if (cmd.data_dir.empty() && !cmd.camera.given()) {
     throw InputError("c3po selftrain", "no clouds given (--data DIR, --depth/--mask or --bop DIR)");
   }
-  if (!sources.empty()) {
-    UnlabelledClouds camera = LoadUnlabelledClouds(sources);
-    for (const std::string& skipped : camera.skipped) {
-      std::fprintf(stderr, "c3po selftrain: skipped %s\n", skipped.c_str());
-    }
-    const AugmentOptions& augment = cmd.augment;
-    const std::size_t instances = camera.clouds.size();
-    camera = Augment(camera, augment);
-    std::fprintf(stderr, "c3po selftrain: %zu real instances (%zu skipped) -> %zu augmented clouds (%d copies, "
-                 "dropout %.3g, noise %.4g)\n", instances, camera.skipped.size(), camera.clouds.size(),
-                 augment.copies, augment.drop_fraction, augment.noise_sigma);
+  if (!camera.clouds.empty()) {
     // Camera groups come after the dataset's: no two inputs share a group.
     const int offset = data.groups.empty() ? 0 : *std::max_element(data.groups.begin(), data.groups.end()) + 1;
     for (std::size_t i = 0; i < camera.clouds.size(); ++i) {
@@ -272,16 +239,9 @@ RunFunction SetupSelftrain(CLI::App& command) {
   AddRobustOptions(command, &cmd->robust);
   AddSeedOption(command, &o.seed, "split, shuffling");
   command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt");
-  AddFrameOptions(command, &cmd->frame);
-  AddBopOptions(command, &cmd->bop, BopDetections::kRefused);
-  AddSegmentOptions(command, &cmd->segment);
-  command.add_option("--copies", cmd->augment.copies,
-                     "Augmented copies per real instance (camera inputs; 0 = the instances as read; with --data: per cloud when "
-                     "more than 1)");
-  command.add_option("--dropout", cmd->augment.drop_fraction,
-                     "Augmentation: fraction of each copy's points dropped");
-  command.add_option("--noise", cmd->augment_noise,
-                     "Augmentation: Gaussian noise sigma per coordinate (a distance: 1mm, 0.001, 0.5%d)");
+  AddCameraCloudOptions(command, &cmd->camera, "",
+                        "Augmented copies per real instance (camera inputs; 0 = the instances as read; with --data: "
+                        "per cloud when more than 1)");
   return [cmd]() { return Run(*cmd); };
 }
 

@@ -6,7 +6,10 @@
 #include <sstream>
 
 #include "c3po/base/atomic_file.hpp"
+#include "c3po/base/error.hpp"
 #include "c3po/base/parallel.hpp"
+#include "c3po/method/image_sources.hpp"
+#include "c3po/object/object_io.hpp"
 #include "progress_bar.hpp"
 
 namespace c3po::cli {
@@ -21,6 +24,49 @@ std::vector<PointSet> LoadDatasetClouds(const Dataset& dataset, const std::strin
   });
   progress.Finish();
   return clouds;
+}
+
+UnlabelledClouds LoadCameraClouds(CameraCloudFlags* flags, const ObjectModel& object, std::uint64_t seed,
+                                  const std::string& command, bool need_truth) {
+  flags->augment.noise_sigma = ParseThreshold(flags->noise, object.diameter(), flags->noise_flag);
+  flags->augment.seed = seed;
+  try {
+    flags->augment.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  CheckSegmentOptions(flags->segment, command);
+  std::vector<CloudSource> sources;
+  if (flags->frame.given()) {
+    for (auto& s : FrameSources(ResolveFrame(flags->frame, command), flags->segment)) sources.push_back(s);
+  }
+  if (!flags->bop.dir.empty()) {
+    const BopInstances listed = ListBopInstances(flags->bop.dir, flags->bop.options);
+    if (listed.instances.empty()) {
+      throw InputError(flags->bop.dir, "no instances of obj_id " + std::to_string(flags->bop.options.obj_id) +
+                                           (flags->bop.options.targets_path.empty() ? "" : " among the targets"));
+    }
+    for (auto& s : BopSources(listed, flags->segment)) sources.push_back(s);
+  }
+  if (sources.empty()) return {};
+  if (need_truth) {
+    for (const CloudSource& source : sources) {
+      if (!source.scene_from_model_truth) {
+        throw InputError(source.name, "no ground-truth pose to label it with (" + command +
+                                          " needs a BOP scene with scene_gt.json)");
+      }
+    }
+  }
+  UnlabelledClouds camera = LoadUnlabelledClouds(sources);
+  for (const std::string& skipped : camera.skipped) {
+    std::fprintf(stderr, "%s: skipped %s\n", command.c_str(), skipped.c_str());
+  }
+  const std::size_t instances = camera.clouds.size();
+  camera = Augment(camera, flags->augment);
+  std::fprintf(stderr, "%s: %zu real instances (%zu skipped) -> %zu augmented clouds (%d copies, dropout %.3g, "
+               "noise %.4g)\n", command.c_str(), instances, camera.skipped.size(), camera.clouds.size(),
+               flags->augment.copies, flags->augment.drop_fraction, flags->augment.noise_sigma);
+  return camera;
 }
 
 EpochLogFile::EpochLogFile(std::string model_path) : path_(std::move(model_path) + ".log.jsonl") {}

@@ -271,6 +271,14 @@ if [ "${C3PO_WITH_POINTNET:-ON}" != OFF ] && [ -e cube.model ]; then
   check selftrain_bop_missing_mask "2" st.model scene_gt.json split_missing_mask cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --bop split_missing_mask --obj-id 1 -o st.model
   check selftrain_depth_mask_sizes "2" st.model mask_small.png depth.png mask_small.png cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --depth depth.png --mask mask_small.png --camera camera.json -o st.model
   check selftrain_copies "2" st.model "copies" split_ok cube.model -- "$C3PO" selftrain "$CUBE" --model cube.model --bop split_ok --obj-id 1 --copies 5000 -o st.model
+  # train on real frames / fine-tuning (issue 18, supervised bound): no ground truth, wrong obj id, incompatible --init
+  mkdir -p split_no_gt && cp -r split_ok/. split_no_gt/ && rm split_no_gt/000001/scene_gt.json
+  check train_bop_no_gt "2" tr.model scene_gt.json split_no_gt -- "$C3PO" train "$CUBE" --bop split_no_gt --obj-id 1 -o tr.model --epochs 1
+  check train_frame_no_gt "2" tr.model "ground-truth pose" depth.png mask.png -- "$C3PO" train "$CUBE" --depth depth.png --mask mask.png --camera camera.json -o tr.model --epochs 1
+  check train_bop_wrong_obj "2" tr.model "obj_id 7" split_ok -- "$C3PO" train "$CUBE" --bop split_ok --obj-id 7 -o tr.model --epochs 1
+  check train_init_shape "2" tr.model cube.model split_ok cube.model -- "$C3PO" train "$CUBE" --init cube.model --bop split_ok --obj-id 1 --head 16 -o tr.model --epochs 1
+  check train_init_other_obj "2" tr.model cube.model sim cube.model other.json -- "$C3PO" train other.json --init cube.model --data sim -o tr.model --epochs 1
+  check train_init_truncated "2" tr.model truncated.model sim truncated.model -- "$C3PO" train "$CUBE" --init truncated.model --data sim -o tr.model --epochs 1
 fi
 
 echo "failures: $failures"

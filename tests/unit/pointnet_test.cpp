@@ -314,6 +314,55 @@ TEST_CASE("a resumed checkpoint gives the weights of an uninterrupted run") {
   CHECK_THROWS_AS(other_shape.LoadCheckpoint(dir / "state.ckpt"), c3po::InputError);
 }
 
+TEST_CASE("fine-tuning: epoch 0 is the starting weights, kept unless an epoch beats them") {
+  const auto train = ToyDataset(16, 40, 21);
+  const auto validation = ToyDataset(6, 40, 22);
+  // A model trained a little (the "init model"), then fine-tuned from its weights.
+  PointNetDetector init(Identity("toy", 2), SmallArchitecture(32), 5);
+  auto options = ToyOptions(32);
+  init.Fit(train, validation, options);
+  const std::vector<float> init_weights = init.GetWeights();
+  const PointNetDetector::Evaluation init_on_validation = init.Evaluate(validation);
+  const PointNetDetector::Evaluation init_on_train = init.Evaluate(train);
+
+  // A step size that throws the network out of its basin: every epoch is worse.
+  PointNetDetector thrown(Identity("toy", 2), SmallArchitecture(32), 77);
+  thrown.SetWeights(init_weights);
+  auto bad = options;
+  bad.optimizer = "sgd";
+  bad.lr = 5.0;
+  bad.epochs = 2;
+  bad.validate_initial = true;
+  std::vector<int> logged;
+  const auto result = thrown.Fit(train, validation, bad, [&](const c3po::EpochLog& log) { logged.push_back(log.epoch); });
+  CHECK(logged == std::vector<int>{0, 1, 2});
+  REQUIRE(result.epochs.size() == 3u);
+  const c3po::EpochLog& zero = result.epochs.front();
+  CHECK(zero.epoch == 0);
+  CHECK(zero.val_keypoint_error == init_on_validation.keypoint_error);
+  CHECK(zero.val_loss == init_on_validation.loss);
+  CHECK(zero.train_loss == init_on_train.loss);   // no augmentation at epoch 0
+  REQUIRE(result.epochs[1].val_loss > zero.val_loss);
+  REQUIRE(result.epochs[2].val_loss > zero.val_loss);
+  CHECK(result.best_epoch == 0);
+  CHECK(thrown.GetWeights() == init_weights);
+
+  // A sensible step size on the same data: a later epoch beats epoch 0 and is kept.
+  PointNetDetector tuned(Identity("toy", 2), SmallArchitecture(32), 78);
+  tuned.SetWeights(init_weights);
+  auto good = options;
+  good.epochs = 30;
+  good.validate_initial = true;
+  const auto better = tuned.Fit(train, validation, good);
+  CHECK(better.epochs.front().val_loss == init_on_validation.loss);
+  CHECK(better.best_epoch > 0);
+  CHECK(tuned.Evaluate(validation).loss < init_on_validation.loss);
+  // Without validate_initial there is no epoch 0 (fresh training is unchanged).
+  PointNetDetector plain(Identity("toy", 2), SmallArchitecture(32), 78);
+  plain.SetWeights(init_weights);
+  CHECK(plain.Fit(train, validation, options).epochs.front().epoch == 1);
+}
+
 TEST_CASE("pointnet model files: round trip, wrong object, truncated and corrupt files") {
   c3po::test::TempDir dir("pointnet_model");
   Rng rng(8);

@@ -9,6 +9,7 @@
 // training calls).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <map>
 #include <set>
 
@@ -256,6 +257,70 @@ TEST_CASE("self-training splits by group: whole groups are trained on, at least 
   const std::vector<int> short_groups(3, 0);
   CHECK_THROWS_AS(SelfTrain(object, clouds, detector, options, {}, {}, false, nullptr, &short_groups),
                   std::invalid_argument);
+}
+
+TEST_CASE("SplitValidation: a partition of the clouds, whole groups, the stated fraction") {
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    // Without groups: round(f n) held out, every index exactly once.
+    const ValidationSplit plain = SplitValidation(40, nullptr, 0.2, seed, "test");
+    CHECK(plain.validation.size() == 8u);
+    std::vector<int> all = plain.validation;
+    all.insert(all.end(), plain.train.begin(), plain.train.end());
+    std::sort(all.begin(), all.end());
+    for (int i = 0; i < 40; ++i) CHECK(all[static_cast<std::size_t>(i)] == i);
+    // With groups of 3 (an image's augmented copies): never cut.
+    std::vector<int> groups;
+    for (int i = 0; i < 30; ++i) groups.push_back(i / 3);
+    const ValidationSplit by_image = SplitValidation(30, &groups, 0.25, seed, "test");
+    std::set<int> held_groups, trained_groups;
+    for (int i : by_image.validation) held_groups.insert(groups[static_cast<std::size_t>(i)]);
+    for (int i : by_image.train) trained_groups.insert(groups[static_cast<std::size_t>(i)]);
+    for (int g : held_groups) CHECK(trained_groups.count(g) == 0);
+    CHECK(by_image.validation.size() + by_image.train.size() == 30u);
+    CHECK(by_image.validation.size() % 3 == 0);
+    CHECK(by_image.validation.size() >= 9u);   // round(0.25 * 30) = 8, whole groups of 3
+    CHECK(by_image.validation.size() <= 8u + 2u + 1u);
+    // Same seed, same split.
+    const ValidationSplit again = SplitValidation(30, &groups, 0.25, seed, "test");
+    CHECK(again.validation == by_image.validation);
+  }
+  const std::vector<int> one(5, 0);
+  CHECK_THROWS_WITH_AS(SplitValidation(5, &one, 0.2, 1, "c3po train"), doctest::Contains("c3po train"), InputError);
+  CHECK_THROWS_AS(SplitValidation(1, nullptr, 0.2, 1, "test"), std::invalid_argument);
+}
+
+TEST_CASE("LabelWithTruth: each cloud's label is the object's keypoints posed at its truth") {
+  const ObjectModel object = test::AsymmetricObject(2000);
+  UnlabelledClouds clouds;
+  Rng rng(9);
+  std::vector<Pose> poses;
+  for (int i = 0; i < 4; ++i) {
+    Pose pose;
+    pose.R = Eigen::Quaterniond(rng.Normal(), rng.Normal(), rng.Normal(), rng.Normal()).normalized().toRotationMatrix();
+    pose.t = Eigen::Vector3d(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(1, 3));
+    poses.push_back(pose);
+    clouds.clouds.push_back(RandomCloud(50, 100 + i));
+    clouds.truth.push_back(pose);
+    clouds.names.push_back("cloud" + std::to_string(i));
+    clouds.groups.push_back(i);
+    clouds.labels.push_back("");
+  }
+  const std::vector<TrainingSample> samples = LabelWithTruth(clouds, object, "c3po train");
+  REQUIRE(samples.size() == 4u);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    CHECK(samples[i].cloud == clouds.clouds[i]);
+    REQUIRE(samples[i].keypoints.cols() == object.num_keypoints());
+    for (int k = 0; k < object.num_keypoints(); ++k) {
+      // Oracle: x = R b + t written out entry by entry.
+      for (int r = 0; r < 3; ++r) {
+        double expected = poses[i].t(r);
+        for (int c = 0; c < 3; ++c) expected += poses[i].R(r, c) * object.keypoints()(c, k);
+        CHECK(samples[i].keypoints(r, k) == doctest::Approx(expected).epsilon(1e-12));
+      }
+    }
+  }
+  clouds.truth[2].reset();
+  CHECK_THROWS_WITH_AS(LabelWithTruth(clouds, object, "c3po train"), doctest::Contains("cloud2"), InputError);
 }
 
 TEST_CASE("mixed camera inputs: another object's augmented instances are never pseudo-labels") {

@@ -18,6 +18,7 @@
 #include "c3po/base/parallel.hpp"
 #include "c3po/base/random.hpp"
 #include "c3po/geometry/distances.hpp"
+#include "c3po/method/selftrain_inputs.hpp"
 
 namespace c3po {
 
@@ -302,38 +303,11 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   if (groups != nullptr && groups->size() != clouds.size()) {
     throw std::invalid_argument("SelfTrain: groups must match the clouds");
   }
-  // Deterministic split: a seeded shuffle, the first part held out.
-  std::vector<int> all(clouds.size());
-  std::iota(all.begin(), all.end(), 0);
-  all = Shuffled(all, Rng::ForItem(options.seed, 0xC3B0));
-  std::size_t validation_count = std::clamp<std::size_t>(
-      static_cast<std::size_t>(std::lround(options.validation_fraction * clouds.size())), 1, clouds.size() - 1);
-  if (groups != nullptr) {
-    // Split by group (e.g. by image: the augmented copies of one real
-    // instance, and the instances of one image, are never on both sides):
-    // whole groups in a seeded order are held out until the validation part
-    // reaches its size; at least one group is held out and one trained on.
-    std::vector<int> distinct(groups->begin(), groups->end());
-    std::sort(distinct.begin(), distinct.end());
-    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
-    if (distinct.size() < 2) {
-      throw InputError("selftrain", "the clouds come from one image: need at least 2 to split into training and "
-                                    "validation");
-    }
-    distinct = Shuffled(distinct, Rng::ForItem(options.seed, 0xC3B0));
-    std::vector<std::vector<int>> members(distinct.size());
-    std::map<int, std::size_t> rank_of;
-    for (std::size_t r = 0; r < distinct.size(); ++r) rank_of[distinct[r]] = r;
-    for (int i : all) members[rank_of.at((*groups)[i])].push_back(i);
-    const std::size_t target = validation_count;
-    all.clear();
-    validation_count = 0;
-    for (std::size_t r = 0; r < members.size(); ++r) {
-      const bool held_out = r == 0 || (validation_count < target && r + 1 < members.size());
-      if (held_out) validation_count += members[r].size();
-      all.insert(all.end(), members[r].begin(), members[r].end());
-    }
-  }
+  // The split (by group when given): selftrain_inputs.hpp SplitValidation.
+  const ValidationSplit split = SplitValidation(clouds.size(), groups, options.validation_fraction, options.seed, "selftrain");
+  std::vector<int> all = split.validation;
+  all.insert(all.end(), split.train.begin(), split.train.end());
+  const std::size_t validation_count = split.validation.size();
   std::vector<PointSet> validation;
   std::vector<Pose> validation_truth;
   for (std::size_t k = 0; k < validation_count; ++k) {

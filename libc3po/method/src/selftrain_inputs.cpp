@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "c3po/base/error.hpp"
 #include "c3po/base/parallel.hpp"
 #include "c3po/base/random.hpp"
 
@@ -111,6 +112,75 @@ UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions
     result.labels.push_back(instances.labels[i]);
   }
   return result;
+}
+
+namespace {
+std::vector<int> Shuffled(std::vector<int> indices, Rng rng) {
+  for (int i = static_cast<int>(indices.size()) - 1; i > 0; --i) {
+    std::swap(indices[i], indices[rng.UniformInt(i + 1)]);
+  }
+  return indices;
+}
+}  // namespace
+
+ValidationSplit SplitValidation(std::size_t count, const std::vector<int>* groups, double fraction,
+                                std::uint64_t seed, const std::string& command) {
+  if (count < 2) throw std::invalid_argument("SplitValidation: need at least 2 clouds");
+  if (groups != nullptr && groups->size() != count) {
+    throw std::invalid_argument("SplitValidation: groups must match the clouds");
+  }
+  // Deterministic split: a seeded shuffle, the first part held out.
+  std::vector<int> all(count);
+  std::iota(all.begin(), all.end(), 0);
+  all = Shuffled(all, Rng::ForItem(seed, 0xC3B0));
+  std::size_t validation_count =
+      std::clamp<std::size_t>(static_cast<std::size_t>(std::lround(fraction * count)), 1, count - 1);
+  if (groups != nullptr) {
+    // Split by group (e.g. by image: the augmented copies of one real
+    // instance, and the instances of one image, are never on both sides).
+    std::vector<int> distinct(groups->begin(), groups->end());
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    if (distinct.size() < 2) {
+      throw InputError(command, "the clouds come from one image: need at least 2 to split into training and "
+                                "validation");
+    }
+    distinct = Shuffled(distinct, Rng::ForItem(seed, 0xC3B0));
+    std::vector<std::vector<int>> members(distinct.size());
+    std::map<int, std::size_t> rank_of;
+    for (std::size_t r = 0; r < distinct.size(); ++r) rank_of[distinct[r]] = r;
+    for (int i : all) members[rank_of.at((*groups)[i])].push_back(i);
+    const std::size_t target = validation_count;
+    all.clear();
+    validation_count = 0;
+    for (std::size_t r = 0; r < members.size(); ++r) {
+      const bool held_out = r == 0 || (validation_count < target && r + 1 < members.size());
+      if (held_out) validation_count += members[r].size();
+      all.insert(all.end(), members[r].begin(), members[r].end());
+    }
+  }
+  ValidationSplit split;
+  split.validation.assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(validation_count));
+  split.train.assign(all.begin() + static_cast<std::ptrdiff_t>(validation_count), all.end());
+  return split;
+}
+
+std::vector<TrainingSample> LabelWithTruth(const UnlabelledClouds& clouds, const ObjectModel& object,
+                                           const std::string& command) {
+  if (clouds.truth.size() != clouds.clouds.size() || clouds.names.size() != clouds.clouds.size()) {
+    throw std::invalid_argument("LabelWithTruth: truth and names must have one entry per cloud");
+  }
+  std::vector<TrainingSample> samples;
+  samples.reserve(clouds.clouds.size());
+  for (std::size_t i = 0; i < clouds.clouds.size(); ++i) {
+    if (!clouds.truth[i]) {
+      throw InputError(command, clouds.names[i] + ": no ground-truth pose to label it with (train needs "
+                                                  "scene_gt.json, or a manifest with keypoints)");
+    }
+    // Label = the keypoints posed at the truth: scene_from_model * keypoints.
+    samples.push_back({clouds.clouds[i], *clouds.truth[i] * object.keypoints()});
+  }
+  return samples;
 }
 
 }  // namespace c3po

@@ -182,6 +182,25 @@ PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train
     impl.optimizer.reset();
   }
   impl.EnsureOptimizer(options);
+  if (options.validate_initial && impl.progress.epochs_done == 0) {
+    // Epoch 0: the starting weights, kept unless an epoch beats them.
+    const auto start = Clock::now();
+    std::vector<TrainingSample> train_set;
+    for (const auto* s : split.train) train_set.push_back(*s);
+    EpochLog log;
+    log.epoch = 0;
+    log.train_loss = Evaluate(train_set).loss;
+    const Evaluation evaluation = Evaluate(validation_set);
+    log.val_loss = evaluation.loss;
+    log.val_keypoint_error = evaluation.keypoint_error;
+    log.best = true;
+    impl.progress.best_val_loss = validation_set.empty() ? std::nan("") : evaluation.loss;
+    impl.progress.best_epoch = 0;
+    impl.progress.best_weights = impl.network->Weights();
+    log.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    impl.progress.history.push_back(log);
+    if (on_epoch) on_epoch(log);
+  }
   const pointnet::Augmentation augmentation{options.rotate_about_camera_deg, options.point_dropout,
                                             options.noise_sigma};
   const double scale = impl.identity.scale;

@@ -14,6 +14,8 @@
 
 #include "c3po/base/types.hpp"
 #include "c3po/method/certify_batch.hpp"
+#include "c3po/method/detector.hpp"
+#include "c3po/object/object_model.hpp"
 
 namespace c3po {
 
@@ -52,5 +54,27 @@ UnlabelledClouds LoadUnlabelledClouds(const std::vector<CloudSource>& sources);
 // their original order) and adds N(0, noise_sigma^2) to every coordinate.
 // std::invalid_argument when the per-cloud vectors differ in length.
 UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions& options);
+
+// The validation split of self-training and of supervised training on camera
+// frames: indices into `count` clouds, validation first. Without groups, a
+// seeded shuffle whose first round(fraction * count) (at least 1, at most
+// count - 1) are held out. With `groups` (one per cloud, e.g. the image of
+// each instance and of its augmented copies): whole groups in a seeded order
+// are held out until the validation part reaches that size; at least one
+// group is held out and one trained on (InputError naming `command` with
+// fewer than 2 groups). Requires count >= 2 (std::invalid_argument).
+struct ValidationSplit {
+  std::vector<int> validation;
+  std::vector<int> train;
+};
+ValidationSplit SplitValidation(std::size_t count, const std::vector<int>* groups, double fraction,
+                                std::uint64_t seed, const std::string& command);
+
+// Supervised labels from ground truth (`c3po train --bop`): every cloud with
+// the object's keypoints posed at its truth, truth[i] * object.keypoints(),
+// in the cloud's frame (the camera's, for BOP instances). InputError naming
+// `command` and the cloud when a cloud has no ground truth.
+std::vector<TrainingSample> LabelWithTruth(const UnlabelledClouds& clouds, const ObjectModel& object,
+                                           const std::string& command);
 
 }  // namespace c3po

@@ -84,11 +84,16 @@ struct PointNetTrainOptions {
   // the same weights as an uninterrupted run with the same options and data.
   std::string checkpoint_path;
   bool resume = false;
+  // Fine-tuning (train --init): Fit first evaluates the weights it starts
+  // from as "epoch 0" (train loss on the training part without augmentation,
+  // validation loss and keypoint error), logs it and keeps those weights
+  // unless an epoch beats them on validation.
+  bool validate_initial = false;
   void Check() const;                        // throws std::invalid_argument
 };
 
 struct EpochLog {
-  int epoch = 0;                             // 1-based
+  int epoch = 0;                             // 1-based (0 = the starting weights, with validate_initial)
   double train_loss = 0.0;                   // mean squared keypoint error, object units^2
   double val_loss = 0.0;                     // same on the validation set (NaN if none)
   double val_keypoint_error = 0.0;           // mean keypoint distance, object units (NaN if none)
