@@ -104,7 +104,7 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
   try {
     options.Check();
   } catch (const std::invalid_argument& e) {
-    throw InputError("c3po bench corrector", e.what());
+    throw InputError("corrector", e.what());
   }
   ProgressBar progress("corrector", 1);
   std::vector<CorrectorBenchmarkCase> cases;
@@ -191,7 +191,7 @@ RunFunction SetupBench(CLI::App& command) {
   SetupCorrectorBench(command, run.get());
   for (const auto& entry : BenchEntries()) entry.setup(command, run.get());
   return [run]() {
-    if (!*run) throw InputError("c3po bench", "choose a benchmark");
+    if (!*run) throw InputError("choose a benchmark");
     return (*run)();
   };
 }

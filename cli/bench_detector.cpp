@@ -28,9 +28,9 @@ struct DetectorBenchCommand {
 
 int RunDetectorBench(const DetectorBenchCommand& cmd) {
   if (cmd.detector.models.size() + cmd.detector.detectors.size() != 1) {
-    throw InputError("c3po bench detector", "give exactly one of --model FILE or --detector NAME");
+    throw InputError("detector", "give exactly one of --model FILE or --detector NAME");
   }
-  if (cmd.count < 0) throw InputError("c3po bench detector", "--count must be >= 0");
+  if (cmd.count < 0) throw InputError("detector", "--count must be >= 0");
   const ObjectModel object = LoadObject(cmd.object_path);
   const Dataset dataset = ReadDataset(cmd.data_dir);
   LoadPlugins(cmd.detector);

@@ -43,7 +43,7 @@ void BenchOne(const std::string& path, double seconds) {
 }
 
 int RunMeshBench(const MeshBenchCommand& cmd) {
-  if (!(cmd.seconds > 0.0)) throw InputError("c3po bench mesh", "--seconds must be positive");
+  if (!(cmd.seconds > 0.0)) throw InputError("mesh", "--seconds must be positive");
   for (const std::string& path : cmd.meshes) BenchOne(path, cmd.seconds);
   return 0;
 }

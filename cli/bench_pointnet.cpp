@@ -25,7 +25,7 @@ void SetupPointNetBench(CLI::App& parent, std::function<int()>* run) {
       try {
         options->Check();
       } catch (const std::invalid_argument& e) {
-        throw InputError("c3po bench pointnet", e.what());
+        throw InputError("pointnet", e.what());
       }
       const PointNetBenchmarkResult r = RunPointNetBenchmark(*options);
       std::printf("pointnet (%zu parameters), n = %d, N = %d, %d thread(s):\n", r.parameters, options->num_points,

@@ -56,7 +56,7 @@ int RunSegmentsBench(const SegmentsBenchCommand& cmd) {
       try {
         variant.Check();
       } catch (const std::invalid_argument& e) {
-        throw InputError("c3po bench segments", e.what());
+        throw InputError("segments", e.what());
       }
       options.variants.push_back(variant);
     }

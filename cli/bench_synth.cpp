@@ -47,10 +47,10 @@ void RunOne(const Mesh& mesh, const PointSet& keypoints, const std::string& labe
 
 int RunSynthBench(const SynthBenchCommand& cmd) {
   if (cmd.object.empty() == cmd.mesh.empty()) {
-    throw InputError("c3po bench synth", "give either OBJECT.json or --mesh FILE");
+    throw InputError("synth", "give either OBJECT.json or --mesh FILE");
   }
   if (!(cmd.seconds > 0.0) || cmd.batch < 1) {
-    throw InputError("c3po bench synth", "--seconds and --batch must be positive");
+    throw InputError("synth", "--seconds and --batch must be positive");
   }
   Mesh mesh;
   PointSet keypoints;

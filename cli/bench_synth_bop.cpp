@@ -27,10 +27,10 @@ struct SynthBopBenchCommand {
 
 int RunSynthBopBench(const SynthBopBenchCommand& cmd) {
   if (cmd.object.empty() == cmd.mesh.empty()) {
-    throw InputError("c3po bench synth-bop", "give either OBJECT.json or --mesh FILE");
+    throw InputError("synth-bop", "give either OBJECT.json or --mesh FILE");
   }
   if (!(cmd.seconds > 0.0) || cmd.batch < 1) {
-    throw InputError("c3po bench synth-bop", "--seconds and --batch must be positive");
+    throw InputError("synth-bop", "--seconds and --batch must be positive");
   }
   Mesh mesh;
   std::string label;

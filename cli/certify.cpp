@@ -184,13 +184,13 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
 int Run(const CertifyCommand& cmd) {
   const std::size_t detectors = cmd.detector.models.size() + cmd.detector.detectors.size();
   if (!cmd.poses_path.empty() && detectors != 0) {
-    throw InputError("c3po certify", "--poses replaces the detector: give no --model / --detector with it");
+    throw InputError("--poses replaces the detector: give no --model / --detector with it");
   }
   if (!cmd.poses_path.empty() && !cmd.bop_csv_path.empty()) {
-    throw InputError("c3po certify", "--bop-csv is not written with --poses (use -o for the JSON lines)");
+    throw InputError("--bop-csv is not written with --poses (use -o for the JSON lines)");
   }
   if (cmd.poses_path.empty() && detectors != 1) {
-    throw InputError("c3po certify", "give exactly one of --model FILE, --detector NAME or --poses FILE");
+    throw InputError("give exactly one of --model FILE, --detector NAME or --poses FILE");
   }
   const ObjectModel object = LoadObject(cmd.object_path);
   CertifyBatchOptions options;
@@ -231,7 +231,7 @@ int Run(const CertifyCommand& cmd) {
     append(BopSources(listed, cmd.segment));
   }
   if (sources.empty()) {
-    throw InputError("c3po certify", "no clouds given (CLOUD..., --data DIR, --depth/--mask or --bop DIR)");
+    throw InputError("no clouds given (CLOUD..., --data DIR, --depth/--mask or --bop DIR)");
   }
   const std::vector<CloudSource> all_sources = shard && !cmd.poses_path.empty() ? sources : std::vector<CloudSource>{};
   if (shard) sources = ShardSources(sources, *shard);

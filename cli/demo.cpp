@@ -41,7 +41,7 @@ struct DemoCommand {
 std::string SelfExecutable() {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw InputError("c3po demo", "cannot locate the c3po executable: " + ec.message());
+  if (ec) throw InputError("cannot locate the c3po executable: " + ec.message());
   // Rebuilt while running: the kernel reports the old inode as "PATH (deleted)";
   // the executable now at PATH is the same program.
   std::string path = self.string();
@@ -63,7 +63,7 @@ std::string DefaultObject() {
        std::vector<std::string>{"annotations/mug.json", bundled.lexically_normal().string()}) {
     if (fs::exists(candidate)) return candidate;
   }
-  throw InputError("c3po demo", "bundled object annotations/mug.json not found (use --object FILE)");
+  throw InputError("bundled object annotations/mug.json not found (use --object FILE)");
 }
 
 // Prints "$ c3po ARGS" and runs it; a failing step stops the demo. Returns
@@ -82,7 +82,7 @@ double Step(const std::string& title, const std::vector<std::string>& args) {
   argv.push_back(nullptr);
   pid_t pid = 0;
   if (posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ) != 0) {
-    throw InputError("c3po demo", "cannot start " + exe);
+    throw InputError("cannot start " + exe);
   }
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
@@ -92,7 +92,7 @@ double Step(const std::string& title, const std::vector<std::string>& args) {
   const bool certify = !args.empty() && args[0] == "certify";
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   if (code != 0 && !(certify && code == 1)) {
-    throw InputError("c3po demo", "step '" + title + "' failed with exit status " + std::to_string(code));
+    throw InputError("step '" + title + "' failed with exit status " + std::to_string(code));
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("(took %.1f s)\n", seconds);

@@ -125,7 +125,7 @@ std::vector<LoadedDetector> LoadDetectors(const EvalCommand& cmd, const ObjectMo
     detectors.push_back(std::move(d));
   }
   if (detectors.empty()) {
-    throw InputError("c3po eval", "give at least one --model FILE, --selftrained FILE or --detector NAME");
+    throw InputError("give at least one --model FILE, --selftrained FILE or --detector NAME");
   }
   return detectors;
 }
@@ -155,7 +155,7 @@ EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object,
   try {
     options.Check();
   } catch (const std::invalid_argument& e) {
-    throw InputError("c3po eval", e.what());
+    throw InputError(e.what());
   }
   return options;
 }
@@ -220,7 +220,7 @@ std::string CommandLine(const EvalCommand& cmd) {
 
 int Run(const EvalCommand& cmd) {
   const ObjectModel object = LoadObject(cmd.object_path);
-  if (cmd.data_dir.empty() == cmd.bop.dir.empty()) throw InputError("c3po eval", "give exactly one of --data DIR or --bop DIR");
+  if (cmd.data_dir.empty() == cmd.bop.dir.empty()) throw InputError("give exactly one of --data DIR or --bop DIR");
   // Fractions of d: the dataset's own diameter (models_info.json) when
   // evaluating BOP data, else the object's bounding-box diagonal.
   double diameter = object.diameter();
@@ -234,7 +234,7 @@ int Run(const EvalCommand& cmd) {
     }
   }
   const EvaluationOptions options = MakeOptions(cmd, object, diameter);
-  if (cmd.views < 0) throw InputError("c3po eval", "--views must be >= 0");
+  if (cmd.views < 0) throw InputError("--views must be >= 0");
   const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
   const std::string empty_part = "this part holds no clouds (choose N at most the number of " +
                                  std::string(cmd.bop.dir.empty() ? "manifest lines)" : "images with usable instances)");

@@ -147,8 +147,8 @@ int RunAuto(const IndicatorsCommand& cmd, ObjectModel& object) {
 int Run(const IndicatorsCommand& cmd) {
   ObjectSpec spec = ReadObjectSpec(cmd.object_path);
   const bool edits = cmd.clear || !cmd.remove_sets.empty() || !cmd.add_sets.empty();
-  if (cmd.automatic && edits) throw InputError("c3po indicators", "--auto cannot be combined with --set/--remove/--clear");
-  if (cmd.write && !cmd.automatic) throw InputError("c3po indicators", "--write only applies to --auto (edits are always written)");
+  if (cmd.automatic && edits) throw InputError("--auto cannot be combined with --set/--remove/--clear");
+  if (cmd.write && !cmd.automatic) throw InputError("--write only applies to --auto (edits are always written)");
   if (edits) {
     IndicatorEdit edit;
     edit.clear = cmd.clear;

@@ -39,7 +39,7 @@ bool IsCsv(const std::string& path) { return path.size() >= 4 && path.compare(pa
 
 int Run(const MergeCommand& cmd) {
   if (cmd.eval) return RunEval(cmd);
-  if (cmd.output_path.empty()) throw InputError("c3po merge", "-o FILE is required (except with --eval)");
+  if (cmd.output_path.empty()) throw InputError("-o FILE is required (except with --eval)");
   std::error_code ec;
   if (std::filesystem::is_directory(cmd.parts.front(), ec)) {   // dataset folders (synth --shard)
     const std::size_t clouds = MergeDatasets(cmd.parts, cmd.output_path, cmd.prefix_parts);

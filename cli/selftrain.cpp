@@ -62,7 +62,7 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
     if (cmd.camera.augment.copies > 1) data = Augment(data, cmd.camera.augment);
   }
   if (cmd.data_dir.empty() && !cmd.camera.given()) {
-    throw InputError("c3po selftrain", "no clouds given (--data DIR, --depth/--mask or --bop DIR)");
+    throw InputError("no clouds given (--data DIR, --depth/--mask or --bop DIR)");
   }
   if (!camera.clouds.empty()) {
     // Camera groups come after the dataset's: no two inputs share a group.
@@ -98,7 +98,7 @@ int Run(SelftrainCommand cmd) {
   try {
     detector->SetTrainOptions(train_options);
   } catch (const std::invalid_argument& e) {
-    throw InputError("c3po selftrain", e.what());
+    throw InputError(e.what());
   }
   SelfTrainOptions& options = cmd.options;
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
@@ -108,14 +108,14 @@ int Run(SelftrainCommand cmd) {
   try {
     options.Check();
   } catch (const std::invalid_argument& e) {
-    throw InputError("c3po selftrain", e.what());
+    throw InputError(e.what());
   }
   if (cmd.resume && !std::filesystem::exists(options.checkpoint_path)) {
     throw InputError(options.checkpoint_path, "no checkpoint to resume from");
   }
   const UnlabelledClouds data = LoadClouds(cmd, object);
   const std::vector<PointSet>& clouds = data.clouds;
-  if (clouds.size() < 2) throw InputError("c3po selftrain", "need at least 2 clouds to self-train");
+  if (clouds.size() < 2) throw InputError("need at least 2 clouds to self-train");
   // Ground truth, when every cloud has it, only feeds the log's reporting
   // columns (rotation error, Hausdorff distance); selection never reads it.
   std::optional<SelfTrainReference> reference;

@@ -107,7 +107,7 @@ int Run(TrainCommand cmd) {
     architecture.Check();
     cmd.options.Check();
   } catch (const std::invalid_argument& e) {
-    throw InputError("c3po train", e.what());
+    throw InputError(e.what());
   }
   std::vector<TrainingSample> train;
   std::vector<int> groups;   // validation unit of each sample: a dataset cloud, or an image
