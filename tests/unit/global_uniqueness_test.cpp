@@ -51,6 +51,18 @@ PipelineOptions Options(const ObjectModel& object) {
   return options;
 }
 
+// A plain box of the given size centred at the origin (keypoints: its corners).
+ObjectModel PlainBox(const Eigen::Vector3d& size) {
+  ObjectSpec spec;
+  spec.name = "box";
+  spec.keypoints = test::BoxMesh({0, 0, 0}, size).vertices;
+  spec.eps_oc = 0.01;
+  spec.delta_nd = 0.008;
+  ObjectModelOptions model_options;
+  model_options.sample_size = 20000;
+  return ObjectModel(spec, test::BoxMesh({0, 0, 0}, size), model_options);
+}
+
 // Points on the box part only (the bump's footprint on the top face removed):
 // every one of them also lies on the model turned by pi about z.
 PointSet BoxOnlyCloud(int count, std::uint64_t seed) {
@@ -132,14 +144,7 @@ TEST_CASE("global uniqueness: a planted two-fold rival is refused; the discrimin
 TEST_CASE("global uniqueness: a symmetric object's turns are not rivals") {
   // A plain box: every half-turn about a principal axis maps it onto itself,
   // so the refined rivals coincide with the estimate as shapes (Hausdorff ~ 0).
-  ObjectSpec spec;
-  spec.name = "box";
-  spec.keypoints = test::BoxMesh({0, 0, 0}, {0.20, 0.10, 0.06}).vertices;
-  spec.eps_oc = 0.01;
-  spec.delta_nd = 0.008;
-  ObjectModelOptions model_options;
-  model_options.sample_size = 20000;
-  const ObjectModel box(spec, test::BoxMesh({0, 0, 0}, {0.20, 0.10, 0.06}), model_options);
+  const ObjectModel box = PlainBox({0.20, 0.10, 0.06});
   const Pose truth = TestPose();
   const PointSet cloud = truth * SampleSurface(box.mesh(), 3000, 5);
   const PoseEstimate e = EstimateAndCertify(box, cloud, truth * box.keypoints(), Options(box));
@@ -276,18 +281,6 @@ TEST_CASE("global uniqueness: the rival slack has a floor in points (few discrim
 
 namespace {
 
-// A 0.20 x 0.12 x 0.06 box (keypoints: its corners).
-ObjectModel PlainBox() {
-  ObjectSpec spec;
-  spec.name = "box";
-  spec.keypoints = test::BoxMesh({0, 0, 0}, {0.20, 0.12, 0.06}).vertices;
-  spec.eps_oc = 0.01;
-  spec.delta_nd = 0.008;
-  ObjectModelOptions model_options;
-  model_options.sample_size = 20000;
-  return ObjectModel(spec, test::BoxMesh({0, 0, 0}, {0.20, 0.12, 0.06}), model_options);
-}
-
 // Points on the top (z = 0.03) and front (y = 0.06) faces with |x| <= half_length:
 // the faces share the edge along x, so the local test sees one weak motion
 // (sliding along x); with half_length = 0.10 the faces are whole.
@@ -306,7 +299,7 @@ PointSet TwoFaces(double half_length, std::uint64_t seed) {
 }  // namespace
 
 TEST_CASE("weak motion: the displacement moves surface points by J(p)^T xi to first order") {
-  const ObjectModel box = PlainBox();
+  const ObjectModel box = PlainBox({0.20, 0.12, 0.06});
   const Eigen::Vector3d centre = box.sample().rowwise().mean();
   const double radius = 0.5 * box.diameter();
   Eigen::Matrix<double, 6, 1> xi;
@@ -323,7 +316,7 @@ TEST_CASE("weak motion: the displacement moves surface points by J(p)^T xi to fi
 }
 
 TEST_CASE("weak motion: a box seen on two whole faces is certified, the faces' middle part is refused") {
-  const ObjectModel box = PlainBox();
+  const ObjectModel box = PlainBox({0.20, 0.12, 0.06});
   const Pose truth = TestPose();
   PipelineOptions options = Options(box);
   options.correct = false;   // certify the true pose itself
@@ -365,7 +358,7 @@ TEST_CASE("weak motion: a box seen on two whole faces is certified, the faces' m
 }
 
 TEST_CASE("weak motion: a single face (three weak motions) is never discharged") {
-  const ObjectModel box = PlainBox();
+  const ObjectModel box = PlainBox({0.20, 0.12, 0.06});
   const Pose truth = TestPose();
   PipelineOptions options = Options(box);
   options.correct = false;

@@ -86,6 +86,7 @@ std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud
     RivalFit fit;
     fit.axis = start.axis;
     fit.angle = start.angle;
+    fit.start = start.scene_from_model;
     const PoseEstimate rival =
         EstimateAndCertify(object, cloud, start.scene_from_model * object.keypoints(), rival_options);
     fit.ok = rival.ok();

@@ -59,9 +59,8 @@ bool Refuted(const Certificate& certificate) {
 // best restart that passes oc_m and free space, if any.
 void Reestimate(const ObjectModel& object, const PointSet& cloud, const PipelineOptions& options,
                 const FreeSpaceTest* free_space, PoseEstimate* estimate) {
-  const PrincipalFrame frame = ModelPrincipalFrame(object);
-  const std::vector<std::pair<int, double>> hypotheses = RivalHypotheses(options.certificate.global);
-  const std::vector<RivalFit> fits = RefineRivals(object, cloud, *estimate, options, frame, hypotheses);
+  const std::vector<RivalFit> fits = RefineRivals(object, cloud, *estimate, options, ModelPrincipalFrame(object),
+                                                  RivalHypotheses(options.certificate.global));
   // Candidates by their outlier count (the rivals' looser budget), best first.
   std::vector<std::size_t> order;
   for (std::size_t i = 0; i < fits.size(); ++i) {
@@ -74,18 +73,15 @@ void Reestimate(const ObjectModel& object, const PointSet& cloud, const Pipeline
   for (const std::size_t i : order) {
     int violations = -1;
     if (free_space && !free_space->Passes(fits[i].scene_from_model, &violations)) continue;
-    const auto& [axis, angle] = hypotheses[i];
-    const Pose turn = std::abs(angle - M_PI) < 1e-12 ? HalfTurn(frame, axis) : AxisRotation(frame, axis, angle);
-    PoseEstimate restarted =
-        EstimateAndCertify(object, cloud, estimate->scene_from_model * turn * object.keypoints(), once, free_space);
+    PoseEstimate restarted = EstimateAndCertify(object, cloud, fits[i].start * object.keypoints(), once, free_space);
     if (!restarted.ok() || Refuted(restarted.certificate)) continue;
     restarted.detected_keypoints = estimate->detected_keypoints;
-    restarted.restart_axis = axis;
-    restarted.restart_angle_deg = angle * 180.0 / M_PI;
+    restarted.restart_axis = fits[i].axis;
+    restarted.restart_angle_deg = fits[i].angle * 180.0 / M_PI;
     *estimate = std::move(restarted);
     break;
   }
-  estimate->restarts_tried = static_cast<int>(hypotheses.size());
+  estimate->restarts_tried = static_cast<int>(fits.size());
 }
 
 }  // namespace

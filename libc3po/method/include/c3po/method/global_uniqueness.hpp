@@ -96,6 +96,7 @@ Pose HalfTurn(const PrincipalFrame& frame, int axis);
 struct RivalFit {
   int axis = -1;
   double angle = 0.0;             // radians
+  Pose start;                     // the pose the fit started from
   bool ok = false;                // the corrector returned a pose
   Pose scene_from_model;
   PointSet keypoints;             // corrected keypoints of the rival
