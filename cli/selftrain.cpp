@@ -38,6 +38,7 @@ struct SelftrainCommand {
   CorrectorFlags corrector;
   RobustFlags robust;
   bool resume = false;
+  std::string symmetry_tolerance;   // distance or fraction of d; "" = eps_oc / 4
   // Camera inputs (docs/camera_inputs.md) and the paper's augmentation.
   CameraCloudFlags camera;
 };
@@ -104,6 +105,10 @@ int Run(SelftrainCommand cmd) {
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
   ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
+  if (!cmd.symmetry_tolerance.empty()) {
+    options.pseudo_labels.symmetry_tolerance =
+        ParseThreshold(cmd.symmetry_tolerance, object.diameter(), "--symmetry-tolerance");
+  }
   options.checkpoint_path = cmd.output_path + ".ckpt";
   try {
     options.Check();
@@ -154,9 +159,9 @@ int Run(SelftrainCommand cmd) {
       [&](const SelfTrainEpochLog& e) {
         progress.Finish();
         log.Record(e.epoch, EpochJson(e).dump());
-        std::fprintf(stderr, "epoch %3d  train oc %5.1f%% (%d ambiguous skipped)  val oc %5.1f%%  identified %5.1f%%  "
+        std::fprintf(stderr, "epoch %3d  train oc %5.1f%% (%d ambiguous skipped, %d symmetric)  val oc %5.1f%%  identified %5.1f%%  "
                      "residual q50 %.3g q90 %.3g  loss %.3e%s%s  %.1fs\n",
-                     e.epoch, e.train_percent_oc, e.ambiguous_skipped, e.validation_percent_oc,
+                     e.epoch, e.train_percent_oc, e.ambiguous_skipped, e.symmetric_trained, e.validation_percent_oc,
                      e.validation_percent_identified, e.validation_residual_q50, e.validation_residual_q90, e.loss,
                      e.rolled_back ? "  ROLLED BACK" : "",
                      e.validation_hausdorff_median >= 0
@@ -234,6 +239,12 @@ RunFunction SetupSelftrain(CLI::App& command) {
                      "A second basin fitting within this factor of the chosen fit's residual makes a sample ambiguous");
   command.add_flag("!--no-ambiguity-check", o.pseudo_labels.check_ambiguity,
                    "Train on every certified sample, ambiguous or not (reproduces the flip regression)");
+  command.add_flag("!--no-symmetry-aware-loss", o.pseudo_labels.symmetry_aware,
+                   "Refuse samples with symmetric labellings as ambiguous instead of training on the labelling "
+                   "nearest the detection");
+  command.add_option("--symmetry-tolerance", cmd->symmetry_tolerance,
+                     "A second basin whose posed model is within this Hausdorff distance of the chosen one is a "
+                     "symmetric labelling (a distance, or e.g. 0.5%d of the diameter; default eps_oc/4)");
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kAllowed);
   AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);

@@ -9,6 +9,24 @@ void PseudoLabelOptions::Check() const {
   if (!(residual_ratio >= 1.0 && std::isfinite(residual_ratio))) {
     throw std::invalid_argument("ambiguity residual ratio must be >= 1");
   }
+  if (!std::isfinite(symmetry_tolerance)) throw std::invalid_argument("symmetry tolerance must be finite");
+}
+
+double PseudoLabelOptions::SymmetryTolerance(double eps_oc) const {
+  return symmetry_tolerance >= 0.0 ? symmetry_tolerance : 0.25 * eps_oc;
+}
+
+const PointSet& NearestLabelling(const PointSet& detected, const PointSet& chosen, const std::vector<PointSet>& others) {
+  const PointSet* nearest = &chosen;
+  double best = (detected - chosen).squaredNorm();
+  for (const PointSet& labelling : others) {
+    const double distance = (detected - labelling).squaredNorm();
+    if (distance < best) {
+      best = distance;
+      nearest = &labelling;
+    }
+  }
+  return *nearest;
 }
 
 double FitResidual(const ObjectModel& object, const PointSet& cloud, const Pose& scene_from_model) {
@@ -24,6 +42,8 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
   check.residual = FitResidual(object, cloud, estimate.scene_from_model);
   if (!options.check_ambiguity || !estimate.ok()) return check;
   const double eps_oc = pipeline.certificate.eps_oc;
+  const double symmetry_tolerance = options.SymmetryTolerance(eps_oc);
+  const PointSet queries = StridedColumns(object.sample(), 1000);
   const std::vector<std::pair<int, double>> half_turns = {{0, M_PI}, {1, M_PI}, {2, M_PI}};
   // This rule judges rivals by exactly oc_m (no slack: the residual ratio
   // below is its own margin).
@@ -33,6 +53,13 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
   for (const RivalFit& rival : RefineRivals(object, cloud, estimate, exact, frame, half_turns)) {
     if (!rival.ok) continue;
     if (rival.keypoint_distance <= eps_oc) continue;   // the same basin
+    if (options.symmetry_aware && rival.passes_oc &&
+        PosedSurfaceHausdorff(object, queries, estimate.scene_from_model, rival.scene_from_model) <=
+            symmetry_tolerance) {
+      // The same shape placed by other keypoints: a symmetric labelling.
+      check.symmetric_labellings.push_back(rival.keypoints);
+      continue;
+    }
     const double residual = FitResidual(object, cloud, rival.scene_from_model);
     if (check.rival_residual < 0 || residual < check.rival_residual) {
       check.rival_residual = residual;

@@ -122,15 +122,14 @@ ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<
   fit.residual_q50 = Quantile(residuals, 0.5);
   fit.residual_q90 = Quantile(residuals, 0.9);
   if (truth != nullptr && truth->size() == clouds.size()) {
-    // At most ~500 model points, evenly strided.
-    const Eigen::Index stride = std::max<Eigen::Index>(1, object.sample().cols() / 500);
-    PointSet model(3, (object.sample().cols() + stride - 1) / stride);
-    for (Eigen::Index j = 0; j < model.cols(); ++j) model.col(j) = object.sample().col(j * stride);
+    // Hausdorff distance between the posed surfaces (~500 model points as
+    // queries, distances to the mesh: a symmetry of the shape costs nothing).
+    const PointSet queries = StridedColumns(object.sample(), 500);
     std::vector<double> rotation, hausdorff;
     for (std::size_t i = 0; i < clouds.size(); ++i) {
       const Pose& estimate = measured.estimates[i].scene_from_model;
       rotation.push_back(RotationAngleDegrees((*truth)[i].R, estimate.R));
-      hausdorff.push_back(HausdorffDistance((*truth)[i] * model, estimate * model));
+      hausdorff.push_back(PosedSurfaceHausdorff(object, queries, (*truth)[i], estimate));
     }
     fit.rotation_error_median = Quantile(rotation, 0.5);
     fit.hausdorff_median = Quantile(hausdorff, 0.5);
@@ -152,7 +151,7 @@ std::vector<int> Shuffled(std::vector<int> indices, Rng rng) {
 #define C3PO_SELFTRAIN_LOG_FIELDS(X)                                                          \
   X(epoch) X(train_percent_oc) X(validation_percent_oc) X(validation_percent_certified)      \
   X(validation_detection_error) X(loss) X(mean_corrector_iterations) X(certified_samples)   \
-  X(ambiguous_skipped) X(validation_percent_identified) X(validation_ambiguous)             \
+  X(ambiguous_skipped) X(symmetric_trained) X(labelling_switched) X(validation_percent_identified) X(validation_ambiguous)             \
   X(validation_residual_q50) X(validation_residual_q90) X(rolled_back)                      \
   X(validation_rotation_error_median) X(validation_hausdorff_median) X(seconds)
 
@@ -216,6 +215,8 @@ struct EpochStats {
   int certified = 0;
   int seen = 0;
   int ambiguous = 0;
+  int symmetric = 0;   // trained samples with symmetric labellings
+  int switched = 0;    // ... whose target was not y* (another labelling was nearer the detection)
   double iterations = 0.0;
 };
 
@@ -235,24 +236,30 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
     std::vector<PointSet> batch;
     for (std::size_t k = start; k < end; ++k) batch.push_back(clouds[order[k]]);
     const std::vector<PoseEstimate> estimates = MeasureCertified(object, batch, detector, options.pipeline).estimates;
-    // Ambiguous pseudo-labels (pseudo_label.hpp) are refused.
-    std::vector<char> usable(batch.size(), 0), ambiguous(batch.size(), 0);
+    // Ambiguous pseudo-labels (pseudo_label.hpp) are refused; a sample with
+    // symmetric labellings is trained on the one nearest its detection (one
+    // step of the symmetry-aware loss min_j ||ỹ - y_j||²).
+    std::vector<PseudoLabelCheck> checks(batch.size());
+    std::vector<char> usable(batch.size(), 0);
     ParallelFor(0, static_cast<int>(batch.size()), [&](int i) {
       if (!estimates[i].ok() || !estimates[i].certificate.oc.passed) return;
-      const PseudoLabelCheck check =
-          CheckPseudoLabel(object, batch[i], estimates[i], options.pipeline, options.pseudo_labels, frame);
-      ambiguous[i] = check.ambiguous;
-      usable[i] = !check.ambiguous;
+      checks[i] = CheckPseudoLabel(object, batch[i], estimates[i], options.pipeline, options.pseudo_labels, frame);
+      usable[i] = !checks[i].ambiguous;
     });
     std::vector<PointSet> certified_clouds, targets;
     for (std::size_t i = 0; i < batch.size(); ++i) {
       stats.iterations += estimates[i].correction.iterations;
       stats.certified += estimates[i].ok() && estimates[i].certificate.oc.passed;
-      stats.ambiguous += ambiguous[i];
+      stats.ambiguous += checks[i].ambiguous;
       if (usable[i]) {
         ++(*pseudo_label_uses)[static_cast<std::size_t>(order[start + i])];
         certified_clouds.push_back(batch[i]);
-        targets.push_back(estimates[i].keypoints);   // pseudo-label: corrected keypoints
+        // Pseudo-label: the corrected keypoints, or the symmetric labelling nearest the detection.
+        const PointSet& target = NearestLabelling(estimates[i].detected_keypoints, estimates[i].keypoints,
+                                                  checks[i].symmetric_labellings);
+        stats.symmetric += !checks[i].symmetric_labellings.empty();
+        stats.switched += &target != &estimates[i].keypoints;
+        targets.push_back(target);
       }
     }
     stats.seen += static_cast<int>(batch.size());
@@ -379,6 +386,8 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     log.mean_corrector_iterations = stats.seen ? stats.iterations / stats.seen : 0.0;
     log.certified_samples = stats.certified;
     log.ambiguous_skipped = stats.ambiguous;
+    log.symmetric_trained = stats.symmetric;
+    log.labelling_switched = stats.switched;
     log.validation_percent_identified = held_out.percent_identified;
     log.validation_ambiguous = held_out.ambiguous;
     log.validation_residual_q50 = held_out.residual_q50;

@@ -1,7 +1,9 @@
 #include "c3po/object/object_model.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <stdexcept>
 
@@ -64,6 +66,9 @@ ObjectModel::ObjectModel(ObjectSpec spec, Mesh mesh, const ObjectModelOptions& o
     normals->col(i) = (b - a).cross(c - a).normalized();
   }
   normals_ = std::move(normals);
+  auto triangles = std::make_shared<std::vector<int>>(static_cast<std::size_t>(sample.points.cols()));
+  for (Eigen::Index i = 0; i < sample.points.cols(); ++i) (*triangles)[static_cast<std::size_t>(i)] = sample.triangle(i);
+  triangles_ = std::move(triangles);
   tree_ = std::make_shared<const PointTree>(std::move(sample.points));
   diameter_ = mesh_.Diameter();
   // Crease flags: a sample point whose 8 nearest sample neighbours include a
@@ -133,6 +138,36 @@ double PosedModelHausdorff(const ObjectModel& object, const PointSet& queries, c
   const double forward = object.DistancesToPosedModel(relative * queries, Pose::Identity()).maxCoeff();
   const double backward = object.DistancesToPosedModel(queries, relative).maxCoeff();
   return std::max(forward, backward);
+}
+
+namespace {
+
+// Largest distance of `points` (model frame) to the triangles of their 8
+// nearest sample points.
+double LargestSurfaceDistance(const ObjectModel& object, const PointSet& points) {
+  const Mesh& mesh = object.mesh();
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3d p = points.col(i);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& neighbour : object.tree().KNearest(p, 16)) {
+      const Eigen::Vector3i tri = mesh.triangles.col(object.sample_triangles()[neighbour.index]);
+      const Eigen::Vector3d closest =
+          ClosestPointOnTriangle(p, mesh.vertices.col(tri(0)), mesh.vertices.col(tri(1)), mesh.vertices.col(tri(2)));
+      nearest = std::min(nearest, (p - closest).norm());
+    }
+    largest = std::max(largest, nearest);
+  }
+  return largest;
+}
+
+}  // namespace
+
+double PosedSurfaceHausdorff(const ObjectModel& object, const PointSet& queries, const Pose& first,
+                             const Pose& second) {
+  const Pose relative = first.Inverse() * second;
+  return std::max(LargestSurfaceDistance(object, relative * queries),
+                  LargestSurfaceDistance(object, relative.Inverse() * queries));
 }
 
 }  // namespace c3po

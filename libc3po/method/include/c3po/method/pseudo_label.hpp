@@ -15,6 +15,17 @@
 // second basin passes the oc certificate itself, or fits with an RMS residual
 // (input points to posed model) within residual_ratio of the chosen one, or
 // fits better than it.
+//
+// Symmetric labellings (method.md "Self-training: symmetric labellings"): a
+// second basin that passes oc and whose posed model lies within
+// symmetry_tolerance of the chosen one (PosedSurfaceHausdorff of T̂·B̂ and
+// T'·B̂: to the surface, free of the sampling floor) places the same shape: a symmetry of the model, not a second
+// explanation. It does not make the sample ambiguous; its keypoints are
+// another correct labelling, and the sample is trained on with the
+// symmetry-aware loss min_j ||ỹ - y_j||² over its labellings (the step's
+// target is the labelling nearest the detection, NearestLabelling).
+#include <vector>
+
 #include "c3po/method/global_uniqueness.hpp"
 #include "c3po/method/pipeline.hpp"
 
@@ -23,7 +34,11 @@ namespace c3po {
 struct PseudoLabelOptions {
   bool check_ambiguity = true;
   double residual_ratio = 1.25;   // rival RMS residual <= ratio * chosen => near-equal
-  void Check() const;             // ratio >= 1 and finite
+  bool symmetry_aware = true;     // symmetric labellings are trained on (min over labellings), not refused
+  double symmetry_tolerance = -1.0;   // object units; < 0: SymmetryTolerance() = eps_oc / 4
+  void Check() const;             // ratio >= 1 and finite; tolerance finite
+  // The tolerance in force for a certificate's eps_oc.
+  double SymmetryTolerance(double eps_oc) const;
 };
 
 struct PseudoLabelCheck {
@@ -33,7 +48,17 @@ struct PseudoLabelCheck {
   bool rival_passes_oc = false;
   double rival_keypoint_distance = 0.0;   // max_i ||y*_i - y'_i|| of that rival
   int rival_axis = -1;               // principal axis (0 = largest extent) of the flip
+  // Keypoints of the second basins that pass oc within the symmetry
+  // tolerance of the chosen pose (symmetry_aware only): y* and these are the
+  // sample's labellings.
+  std::vector<PointSet> symmetric_labellings;
 };
+
+// The target of one step of the symmetry-aware loss min_j ||ỹ - y_j||²: the
+// labelling (`chosen` or one of `others`) nearest the detection `detected`
+// (ties keep the earlier; `chosen` first). Its gradient at the current
+// weights is the regression onto that labelling.
+const PointSet& NearestLabelling(const PointSet& detected, const PointSet& chosen, const std::vector<PointSet>& others);
 
 // RMS distance of the cloud's points to the model sample posed by `pose`.
 double FitResidual(const ObjectModel& object, const PointSet& cloud, const Pose& scene_from_model);

@@ -50,6 +50,8 @@ struct SelfTrainEpochLog {
   double mean_corrector_iterations = 0.0;
   int certified_samples = 0;
   int ambiguous_skipped = 0;          // certified training samples refused as ambiguous
+  int symmetric_trained = 0;          // trained samples with symmetric labellings (symmetry-aware loss)
+  int labelling_switched = 0;         // ... whose target was a labelling other than y* (nearer the detection)
   // Label-free validation criteria.
   double validation_percent_identified = 0.0;  // oc and not ambiguous
   int validation_ambiguous = 0;
@@ -57,7 +59,7 @@ struct SelfTrainEpochLog {
   double validation_residual_q90 = 0.0;
   bool rolled_back = false;                    // worse than the best: the best weights were restored
   // Reporting only, when ground truth was given (never used for selection);
-  // -1 = none. Rotation error in degrees; Hausdorff distance between the model
+  // -1 = none. Rotation error in degrees; Hausdorff distance (PosedSurfaceHausdorff) between the model
   // posed at the truth and at the estimate (object units).
   double validation_rotation_error_median = -1.0;
   double validation_hausdorff_median = -1.0;

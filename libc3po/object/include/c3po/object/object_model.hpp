@@ -54,6 +54,8 @@ class ObjectModel {
   const PointTree& tree() const { return *tree_; }
   // Unit outward normals of B̂ (of the triangle each sample point lies on).
   const PointSet& sample_normals() const { return *normals_; }
+  // Mesh triangle each sample point lies on.
+  const std::vector<int>& sample_triangles() const { return *triangles_; }
   // 1 where a sample point lies at an edge or crease of the mesh (a neighbour
   // among its 8 nearest has a normal > 30 degrees off): its normal does not
   // represent nearby points (local non-degeneracy skips them).
@@ -77,6 +79,7 @@ class ObjectModel {
   Mesh mesh_;
   std::shared_ptr<const PointTree> tree_;
   std::shared_ptr<const PointSet> normals_;
+  std::shared_ptr<const std::vector<int>> triangles_;
   std::shared_ptr<const std::vector<char>> crease_;
   double diameter_ = 0.0;
   mutable double spacing_ = -1.0;
@@ -87,5 +90,14 @@ class ObjectModel {
 // between posed shapes: symmetries of the object cost nothing.
 double PosedModelHausdorff(const ObjectModel& object, const PointSet& queries, const Pose& first,
                            const Pose& second);
+
+// The same with distances to the model *surface*: each point's distance to
+// the mesh triangles of its 16 nearest sample points (exact point-to-triangle
+// distances; an upper bound on the distance to the whole surface, tight
+// where the nearest triangle is among them). Free of the sampling floor
+// (~ the sample spacing) that PosedModelHausdorff carries: an exact symmetry
+// of the surface measures as the fit's difference, not as the spacing.
+double PosedSurfaceHausdorff(const ObjectModel& object, const PointSet& queries, const Pose& first,
+                             const Pose& second);
 
 }  // namespace c3po
