@@ -130,6 +130,9 @@ void AddBopOptions(CLI::App& command, BopFlags* flags, BopDetections detections)
 struct CameraCloudFlags {
   FrameFlags frame;
   BopFlags bop;
+  // selftrain only (--add-obj-id): BOP objects whose instances are added as
+  // unlabelled clouds of other objects (a mixed set; the label is only reported).
+  std::vector<int> other_obj_ids;
   SegmentOptions segment;
   AugmentOptions augment;        // noise_sigma and seed are set when loading
   std::string noise = "1mm";     // a distance: 1mm, 0.001, 0.5%d

@@ -65,6 +65,8 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
   if (cmd.data_dir.empty() && !cmd.camera.given()) {
     throw InputError("no clouds given (--data DIR, --depth/--mask or --bop DIR)");
   }
+  char own_label[32];
+  std::snprintf(own_label, sizeof own_label, "obj_%06d", cmd.camera.bop.options.obj_id);
   if (!camera.clouds.empty()) {
     // Camera groups come after the dataset's: no two inputs share a group.
     const int offset = data.groups.empty() ? 0 : *std::max_element(data.groups.begin(), data.groups.end()) + 1;
@@ -73,8 +75,10 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
       data.groups.push_back(camera.groups[i] + offset);
       data.truth.push_back(camera.truth[i]);
       data.names.push_back(camera.names[i]);
-      // --obj-id names this object's instances, whatever the object file calls it.
-      data.labels.push_back(camera.labels[i].empty() ? "" : object.name());
+      // --obj-id names this object's instances, whatever the object file
+      // calls it; --add-obj-id instances keep their BOP label (obj_0000KK).
+      data.labels.push_back(camera.labels[i].empty() || camera.labels[i] == own_label ? object.name()
+                                                                                        : camera.labels[i]);
     }
   }
   return data;
@@ -250,6 +254,9 @@ RunFunction SetupSelftrain(CLI::App& command) {
   AddRobustOptions(command, &cmd->robust);
   AddSeedOption(command, &o.seed, "split, shuffling");
   command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt");
+  command.add_option("--add-obj-id", cmd->camera.other_obj_ids,
+                     "With --bop: also read the instances of this BOP object as unlabelled clouds (repeatable; a "
+                     "mixed set: their label is only reported, per object, with the pseudo-labels used)");
   AddCameraCloudOptions(command, &cmd->camera, "",
                         "Augmented copies per real instance (camera inputs; 0 = the instances as read; with --data: "
                         "per cloud when more than 1)");

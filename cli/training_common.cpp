@@ -47,6 +47,20 @@ UnlabelledClouds LoadCameraClouds(CameraCloudFlags* flags, const ObjectModel& ob
                                            (flags->bop.options.targets_path.empty() ? "" : " among the targets"));
     }
     for (auto& s : BopSources(listed, flags->segment)) sources.push_back(s);
+    for (const int other : flags->other_obj_ids) {
+      if (other == flags->bop.options.obj_id) {
+        throw InputError("--add-obj-id " + std::to_string(other) + ": that is --obj-id, the object itself");
+      }
+      BopOptions options = flags->bop.options;
+      options.obj_id = other;
+      const BopInstances others = ListBopInstances(flags->bop.dir, options);
+      if (others.instances.empty()) {
+        throw InputError(flags->bop.dir, "no instances of obj_id " + std::to_string(other) + " (--add-obj-id)");
+      }
+      for (auto& s : BopSources(others, flags->segment)) sources.push_back(s);
+    }
+  } else if (!flags->other_obj_ids.empty()) {
+    throw InputError("--add-obj-id needs --bop DIR");
   }
   if (sources.empty()) return {};
   if (need_truth) {

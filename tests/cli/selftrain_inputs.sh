@@ -50,6 +50,29 @@ expect_error dropout "drop fraction" --bop bop --obj-id 4 --dropout 1
 expect_error noise "--noise" --bop bop --obj-id 4 --noise lots
 expect_error no_bop "no_such" --bop no_such --obj-id 4
 expect_error frame_half "--mask" --depth bop/test/000000/depth/000000.png
+expect_error add_self "that is --obj-id" --bop bop --obj-id 4 --add-obj-id 4
+expect_error add_absent "no instances of obj_id 99 (--add-obj-id)" --bop bop --obj-id 4 --add-obj-id 99
+expect_error add_no_bop "--add-obj-id needs --bop" --data no_such_dir --add-obj-id 6
+
+# Real-style mixed data: a BOP scene with a box (obj 6) beside each mug;
+# --add-obj-id 6 adds the box's instances as unlabelled clouds, reported per
+# object (oracle: 4 images x 1 box x 2 copies = 8 box clouds, 8 mug clouds).
+"$C3PO" synth "$MUG" -o bopmix --format bop --count 4 --obj-id 4 --distractors 1 --distractor "$BOX:6" \
+  --intrinsics 400,400,159.5,119.5,320,240 --seed 3 > synthmix.log 2>&1 || fail "synth bopmix: $(tail -2 synthmix.log)"
+"$C3PO" selftrain "$MUG" --model mug.model --bop bopmix --obj-id 4 --add-obj-id 6 --copies 2 --epochs 1 \
+  --eps-oc 60%d --val-fraction 0.25 --seed 1 -o mixbop.model > mixbop.out 2> mixbop.err
+status=$?
+if [ $status -eq 0 ]; then
+  grep -q "self-training on 16 unlabelled clouds" mixbop.err || fail "--add-obj-id: not 16 clouds: $(head -3 mixbop.err)"
+  grep -q "pseudo-labels from obj_000006 clouds: [0-9]* of 8 clouds" mixbop.out \
+    || fail "--add-obj-id: no per-object line for obj 6: $(cat mixbop.out)"
+  grep -q "pseudo-labels from mug clouds (this object): [0-9]* of 8 clouds" mixbop.out \
+    || fail "--add-obj-id: no line for the mug: $(cat mixbop.out)"
+  grep -q '"obj_000006"' mixbop.model || fail "--add-obj-id: no obj_000006 counts in the model header"
+  grep -q "truth:" mixbop.err && fail "--add-obj-id: ground-truth columns on a mixed set"
+else
+  grep -q "nothing to learn from" mixbop.err || fail "selftrain --add-obj-id exited $status: $(cat mixbop.err)"
+fi
 
 # A mixed dataset: the mug's and the box's clouds, labelled.
 "$C3PO" synth "$MUG" -o mug --kind depth --count 8 --points 300 --seed 4 > /dev/null 2>&1 || fail "synth mug"
