@@ -197,6 +197,10 @@ RunFunction SetupIndicators(CLI::App& command) {
   command.add_option("--noise", cmd->noise_text, "--auto: depth noise sigma (object units; default eps_oc / 8)");
   command.add_option("--tolerance", a.degeneracy.tolerance_factor,
                      "--auto: degenerate when a fitting pose is farther (Hausdorff) than this times eps_oc")->capture_default_str();
+  command.add_option("--near-factor", a.degeneracy.near_factor,
+                     "--auto: a degenerate view blocks every set whose keypoints all lie within this times delta_nd "
+                     "of its cloud (a denser view could support them)")
+      ->capture_default_str();
   command.add_option("--max-set-size", a.learning.max_set_size, "--auto: largest candidate set")->capture_default_str();
   command.add_option("--min-support", a.learning.min_support, "--auto: views a set must newly accept")->capture_default_str();
   command.add_option("--borderline", a.learning.borderline_factor,

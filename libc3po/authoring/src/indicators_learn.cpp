@@ -89,7 +89,7 @@ std::vector<LabelledView> UsableLabels(const std::vector<ViewDegeneracy>& views,
       continue;
     }
     labels.push_back({view.seen_mask, view.degenerate,
-                      !view.degenerate && view.worst_hausdorff > borderline_distance});
+                      !view.degenerate && view.worst_hausdorff > borderline_distance, view.near_mask});
   }
   return labels;
 }
@@ -120,7 +120,11 @@ LearnedSets LearnIndicatorSets(const std::vector<LabelledView>& views, int num_k
   bool any_degenerate = false;
   for (const LabelledView& view : views) {
     any_degenerate = any_degenerate || view.degenerate;
-    (view.degenerate || view.borderline ? degenerate_seen : uncovered).push_back(view.seen_mask);
+    if (view.degenerate || view.borderline) {
+      degenerate_seen.push_back(view.seen_mask | view.near_mask);   // blocks what it nearly sees too
+    } else {
+      uncovered.push_back(view.seen_mask);
+    }
   }
   if (!any_degenerate) {
     learned.accept_all = true;   // every training view pins the pose down: nd = 1 always

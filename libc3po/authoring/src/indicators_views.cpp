@@ -63,11 +63,10 @@ std::vector<Eigen::Matrix3d> CubeGroup() {
 }
 
 // Centroid and principal axes (columns by increasing extent, right-handed) of
-// the object's surface sample. Not global_uniqueness.hpp's ModelPrincipalFrame
-// (decreasing extent): the learned sets depend on the order of the deliberate
-// views, and with that order one independent face-on box view was accepted by
-// a learned set (indicators_test) -- a fragility of the set learning, recorded
-// in docs/method.md.
+// the object's surface sample. (With decreasing extent, or with other training
+// seeds, the rendered views differ; before DegeneracyOptions::near_factor some
+// of those runs learned a set that accepted an independent face-on box view:
+// docs/method.md "Deliberate degenerate views".)
 std::pair<Eigen::Vector3d, Eigen::Matrix3d> SurfacePrincipalAxes(const ObjectModel& object) {
   const PointSet& sample = object.sample();
   const Eigen::Vector3d centroid = sample.rowwise().mean();
@@ -297,6 +296,7 @@ void DegeneracyOptions::Check() const {
   if (!(tolerance_factor >= 1.0 && std::isfinite(tolerance_factor))) {
     throw InputError("--tolerance", "must be at least 1 (times eps_oc)");
   }
+  if (!(near_factor >= 1.0 && std::isfinite(near_factor))) throw InputError("--near-factor", "must be at least 1");
   if (screening_iterations < 1) throw InputError("screening_iterations", "must be positive");
   if (!(screening_factor > 0 && std::isfinite(screening_factor))) throw InputError("screening_factor", "must be positive");
   if (search_points < 10) throw InputError("search_points", "must be at least 10");
@@ -338,6 +338,7 @@ ViewDegeneracy AnalyzeViewDegeneracy(const ObjectModel& object, const PointSet& 
   const Eigen::VectorXd keypoint_distances = DistancesToCloud(scene_from_model * object.keypoints(), cloud);
   for (Eigen::Index i = 0; i < keypoint_distances.size(); ++i) {
     if (keypoint_distances(i) < options.delta_nd) result.seen_mask |= std::uint64_t{1} << i;
+    if (keypoint_distances(i) < options.near_factor * options.delta_nd) result.near_mask |= std::uint64_t{1} << i;
   }
   result.true_fit = MaxDistance(object, cloud, scene_from_model);
   result.usable = result.true_fit < options.eps_oc;

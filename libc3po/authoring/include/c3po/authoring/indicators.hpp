@@ -156,6 +156,11 @@ struct DegeneracyOptions {
   double eps_oc = 0.0;          // fit threshold (absolute); <= 0: the object's
   double delta_nd = 0.0;        // "seen" threshold (absolute); <= 0: the object's
   double tolerance_factor = 2.0;   // degenerate iff Hausdorff > tolerance_factor * eps_oc
+  // A degenerate view blocks every candidate set whose keypoints all lie
+  // within near_factor * delta_nd of its cloud, not only those it supports
+  // within delta_nd: a denser or slightly turned cloud of the same view can
+  // support a keypoint the rendered one just misses (near_mask).
+  double near_factor = 2.0;
   int search_points = 200;      // cloud points used by the ICP searches
   int hausdorff_points = 2000;  // model points used for the Hausdorff distances
   IcpOptions icp;               // of each search
@@ -175,6 +180,7 @@ struct ViewDegeneracy {
   int fitting_starts = 0;       // starts whose refined pose fits within eps_oc
   Pose worst_pose;              // the fitting pose achieving worst_hausdorff
   std::uint64_t seen_mask = 0;  // bit i: keypoint i within delta_nd of the cloud at T*
+  std::uint64_t near_mask = 0;  // bit i: within near_factor * delta_nd (a superset of seen_mask)
 };
 
 // The starting poses of the search, as model-frame motions about the sample
@@ -197,6 +203,9 @@ struct LabelledView {
   // degeneracy tolerance: such a view blocks candidates like a degenerate one
   // (a safety margin against views just on the other side of the tolerance).
   bool borderline = false;
+  // Degenerate and borderline views block the candidates all within
+  // seen_mask | near_mask (DegeneracyOptions::near_factor).
+  std::uint64_t near_mask = 0;
 };
 
 struct SetLearningOptions {
