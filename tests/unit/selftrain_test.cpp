@@ -405,6 +405,7 @@ TEST_CASE("symmetric labellings: an exactly symmetric slab's flips are labelling
     CHECK(result.best.hausdorff_median < 0.002);
     // Refusing them instead leaves the detector where it started.
     SelfTrainOptions refuse = options;
+    refuse.epochs = 2;
     refuse.pseudo_labels.symmetry_aware = false;
     OffsetDetector unchanged(start, 0.5);
     const SelfTrainResult refused = SelfTrain(object, clouds, unchanged, refuse);
