@@ -365,4 +365,11 @@ TEST_CASE("selftrain-style logs: percent fields are not rescaled and counts are 
   const std::size_t comma = points.find(',');
   const double y = std::stod(points.substr(comma + 1));
   CHECK(y > 240.0);   // plot area bottom = height 300 - 40 = 260; 0.5 % of 232 px above it
+  // The counts have their own chart, as given (7 and 9 samples, not percentages).
+  const std::size_t counts_start = html.find("self: samples per epoch");
+  REQUIRE(counts_start != std::string::npos);
+  const std::string counts = html.substr(counts_start, html.find("</svg>", counts_start) - counts_start);
+  CHECK(counts.find(">certified_samples<") != std::string::npos);
+  CHECK(counts.find("train_percent_oc") == std::string::npos);
+  CHECK(counts.find(">loss<") == std::string::npos);
 }

@@ -210,22 +210,49 @@ bool IsPercentField(const std::string& name) {
   return name.find("percent") != std::string::npos || name.rfind("oc", 0) == 0 || name.rfind("nd", 0) == 0 ||
          EndsWith(name, "_oc") || EndsWith(name, "_nd") || EndsWith(name, "certified");
 }
+// Sample counts of self-training: "certified_samples", "ambiguous_skipped",
+// "symmetric_trained", "labelling_switched", "validation_ambiguous".
+bool IsCountField(const std::string& name) {
+  return EndsWith(name, "_samples") || EndsWith(name, "_skipped") || EndsWith(name, "_trained") ||
+         EndsWith(name, "_switched") || name == "validation_ambiguous";
+}
 
-// One chart of the fields selected by `select`; percentages scaled to 0..100
-// when every value is a fraction.
-std::string TrainingChart(const TrainingLog& log, bool percent) {
+enum class ChartKind { kLoss, kPercent, kCount };
+
+bool Selects(ChartKind kind, const std::string& name) {
+  switch (kind) {
+    case ChartKind::kLoss: return IsLossField(name);
+    case ChartKind::kPercent: return IsPercentField(name);
+    case ChartKind::kCount: return IsCountField(name);
+  }
+  return false;
+}
+
+std::string ChartTitle(ChartKind kind) {
+  switch (kind) {
+    case ChartKind::kLoss: return ": loss per epoch";
+    case ChartKind::kPercent: return ": certified / observably correct per epoch";
+    case ChartKind::kCount: return ": samples per epoch (certified, ambiguous skipped, symmetric)";
+  }
+  return "";
+}
+
+// One chart of the fields of `kind`; percentages scaled to 0..100 when
+// every value is a fraction.
+std::string TrainingChart(const TrainingLog& log, ChartKind kind) {
+  const bool percent = kind == ChartKind::kPercent;
   std::vector<std::string> fields;
   for (const auto& epoch : log.epochs) {
     for (const auto& [name, value] : epoch) {
-      if (name == "epoch" || !(percent ? IsPercentField(name) : IsLossField(name))) continue;
+      if (name == "epoch" || !Selects(kind, name)) continue;
       if (std::find(fields.begin(), fields.end(), name) == fields.end()) fields.push_back(name);
     }
   }
   if (fields.empty()) return "";
   svg::LineChart chart;
-  chart.title = log.label + (percent ? ": certified / observably correct per epoch" : ": loss per epoch");
+  chart.title = log.label + ChartTitle(kind);
   chart.x_label = "epoch";
-  chart.y_label = percent ? "%" : "value";
+  chart.y_label = percent ? "%" : kind == ChartKind::kCount ? "samples" : "value";
   double x_max = 1.0, y_low = INFINITY, y_high = -INFINITY;
   for (std::size_t f = 0; f < fields.size(); ++f) {
     svg::Series series;
@@ -255,7 +282,7 @@ std::string TrainingChart(const TrainingLog& log, bool percent) {
   if (percent) {
     chart.y_min = 0.0;
     chart.y_max = 100.0;
-  } else if (std::isfinite(y_low) && y_low > 0 && y_high / y_low > 20.0) {
+  } else if (kind == ChartKind::kLoss && std::isfinite(y_low) && y_low > 0 && y_high / y_low > 20.0) {
     chart.log_y = true;
     chart.y_min = y_low;
     chart.y_max = y_high;
@@ -275,7 +302,8 @@ std::string TrainingHtml(const std::vector<TrainingLog>& logs) {
   for (const auto& log : logs) {
     out << "<h3>" << HtmlEscape(log.label) << " <span class=\"note\">(" << HtmlEscape(log.path) << ", "
         << log.epochs.size() << " epochs)</span></h3>\n<div class=\"charts\">\n"
-        << TrainingChart(log, false) << TrainingChart(log, true) << "</div>\n";
+        << TrainingChart(log, ChartKind::kLoss) << TrainingChart(log, ChartKind::kPercent)
+        << TrainingChart(log, ChartKind::kCount) << "</div>\n";
   }
   out << "</section>\n";
   return out.str();
