@@ -4,6 +4,7 @@
 // at scene_gt's pose, augmented with --copies as selftrain does); from fresh
 // weights or fine-tuned from a model (--init).
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -11,6 +12,7 @@
 
 #include "c3po/base/error.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/method/model_symmetries.hpp"
 #include "c3po/method/selftrain_inputs.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/pointnet.hpp"
@@ -34,6 +36,8 @@ struct TrainCommand {
   bool resume = false;
   std::string init_path;                  // --init MODEL: fine-tune from its weights
   CameraCloudFlags camera;                // --bop / --depth,--mask (with ground truth)
+  bool symmetry_aware = true;             // train symmetric objects against min over labellings
+  std::string symmetry_tolerance;         // distance or fraction of d; "" = eps_oc / 4
   // Options whose value the architecture of --init fixes (given = refused if different).
   CLI::Option* points_flag = nullptr;
   CLI::Option* point_mlp_flag = nullptr;
@@ -63,7 +67,7 @@ void CheckInitArchitecture(const TrainCommand& cmd, const PointNetArchitecture& 
 
 std::vector<TrainingSample> Samples(const Dataset& dataset, const std::vector<PointSet>& clouds) {
   std::vector<TrainingSample> samples;
-  for (std::size_t i = 0; i < clouds.size(); ++i) samples.push_back({clouds[i], *dataset.entries[i].keypoints});
+  for (std::size_t i = 0; i < clouds.size(); ++i) samples.push_back({clouds[i], *dataset.entries[i].keypoints, {}});
   return samples;
 }
 
@@ -78,6 +82,25 @@ Dataset ReadLabelled(const std::string& dir, int num_keypoints) {
     }
   }
   return dataset;
+}
+
+// The symmetries of the object (none with --no-symmetry-aware-loss); printed
+// with their evidence.
+std::vector<ModelSymmetry> ObjectSymmetries(const TrainCommand& cmd, const ObjectModel& object) {
+  if (!cmd.symmetry_aware) return {};
+  SymmetrySearchOptions options;
+  options.tolerance = cmd.symmetry_tolerance.empty()
+                          ? 0.25 * object.spec().eps_oc
+                          : ParseThreshold(cmd.symmetry_tolerance, object.diameter(), "--symmetry-tolerance");
+  const std::vector<ModelSymmetry> symmetries = FindModelSymmetries(object, options);
+  std::fprintf(stderr, "%s: %zu symmetr%s within %.3g (surface Hausdorff)%s\n", object.name().c_str(),
+               symmetries.size(), symmetries.size() == 1 ? "y" : "ies", options.tolerance,
+               symmetries.empty() ? "" : ": trained against the nearest of the symmetric labellings");
+  for (const ModelSymmetry& s : symmetries) {
+    std::fprintf(stderr, "  %6.1f deg about (%+.3f, %+.3f, %+.3f), Hausdorff %.3g\n", s.angle * 180.0 / M_PI,
+                 s.axis.x(), s.axis.y(), s.axis.z(), s.hausdorff);
+  }
+  return symmetries;
 }
 
 int Run(TrainCommand cmd) {
@@ -144,6 +167,12 @@ int Run(TrainCommand cmd) {
     train = std::move(kept);
   }
 
+  const std::vector<ModelSymmetry> symmetries = ObjectSymmetries(cmd, object);
+  for (auto* samples : {&train, &validation}) {
+    for (TrainingSample& sample : *samples) {
+      sample.symmetric_keypoints = SymmetricLabellings(object, symmetries, sample.keypoints);
+    }
+  }
   if (!detector) detector = std::make_unique<PointNetDetector>(object, architecture, cmd.options.seed);
   EpochLogFile log(cmd.output_path);
   if (cmd.resume) {
@@ -160,13 +189,15 @@ int Run(TrainCommand cmd) {
   const PointNetFitResult result = detector->Fit(train, validation, cmd.options, [&](const EpochLog& epoch) {
     const nlohmann::json line = {{"phase", "train"}, {"epoch", epoch.epoch}, {"train_loss", epoch.train_loss},
                                  {"val_loss", epoch.val_loss}, {"val_keypoint_error", epoch.val_keypoint_error},
-                                 {"seconds", epoch.seconds}, {"best", epoch.best}};
+                                 {"seconds", epoch.seconds}, {"labellings_switched", epoch.labellings_switched},
+                                 {"best", epoch.best}};
     log.Record(epoch.epoch, line.dump());
     std::fprintf(stderr, "epoch %3d  train loss %.3e  val loss %.3e  val keypoint error %.4g  %.1fs%s\n",
                  epoch.epoch, epoch.train_loss, epoch.val_loss, epoch.val_keypoint_error, epoch.seconds,
                  epoch.best ? "  (best)" : "");
   });
   nlohmann::json extra = nlohmann::json::object();
+  extra["symmetries"] = symmetries.size();
   if (!cmd.init_path.empty()) extra["init_model"] = std::filesystem::path(cmd.init_path).filename().string();
   if (!camera.clouds.empty()) {
     extra["camera_instances"] = camera.clouds.size() / static_cast<std::size_t>(std::max(1, cmd.camera.augment.copies));
@@ -202,6 +233,12 @@ RunFunction SetupTrain(CLI::App& command) {
   command.add_option("--noise", o.noise_sigma, "Augmentation: Gaussian noise sigma (object units)");
   cmd->point_mlp_flag = command.add_option("--point-mlp", cmd->point_mlp, "Widths of the shared point MLP")->delimiter(',');
   cmd->head_flag = command.add_option("--head", cmd->head, "Widths of the hidden head layers")->delimiter(',');
+  command.add_flag("!--no-symmetry-aware-loss", cmd->symmetry_aware,
+                   "Plain mean squared error even for a symmetric object (default: the object's rotational "
+                   "symmetries are found and each cloud is trained against the nearest of its labellings)");
+  command.add_option("--symmetry-tolerance", cmd->symmetry_tolerance,
+                     "A rotation moving the model surface by at most this Hausdorff distance is a symmetry "
+                     "(a distance, or e.g. 0.5%d of the diameter; default eps_oc/4)");
   command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt (same result as an uninterrupted run)");
   command.add_option("--init", cmd->init_path,
                      "Fine-tune from this model's weights (its architecture; epoch 0 = the model, kept unless beaten)");

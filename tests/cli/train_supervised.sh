@@ -78,6 +78,22 @@ cmp -s split.model split2.model || fail "train --bop is not deterministic"
   -o scratch.model > scratch.out 2> scratch.err || fail "train --bop from scratch exited $?: $(tail -1 scratch.err)"
 grep -q '"epoch":0' scratch.model.log.jsonl && fail "train without --init logged an epoch 0"
 
+# Symmetric objects: the box's three half-turns are found and trained against
+# (each cloud's target is the labelling nearest the output; the model header
+# counts the symmetries, the log the switched labellings); the mug has none;
+# --no-symmetry-aware-loss trains plain MSE.
+grep -q "mug: 0 symmetries" ft.err || fail "train mug: no '0 symmetries' line in $(head -3 ft.err)"
+"$C3PO" synth "$BOX" -o boxsim --kind depth --count 20 --points 200 --seed 1 > /dev/null 2>&1 || fail "synth box failed"
+"$C3PO" train "$BOX" --data boxsim -o boxsym.model --epochs 2 --point-mlp 16,16 --head 16 --points 64 --seed 1 \
+  > boxsym.out 2> boxsym.err || fail "train box exited $?: $(tail -2 boxsym.err)"
+grep -q "box: 3 symmetries" boxsym.err || fail "train box: no '3 symmetries' in $(head -3 boxsym.err)"
+grep -q '"symmetries":3' boxsym.model || fail "boxsym.model header does not count 3 symmetries"
+grep -q '"labellings_switched":[1-9]' boxsym.model.log.jsonl || fail "train box: no switched labelling logged"
+"$C3PO" train "$BOX" --data boxsim -o boxplain.model --epochs 2 --point-mlp 16,16 --head 16 --points 64 --seed 1 \
+  --no-symmetry-aware-loss > boxplain.out 2> boxplain.err || fail "train box --no-symmetry-aware-loss exited $?"
+grep -q '"symmetries":0' boxplain.model || fail "boxplain.model header: symmetries not 0"
+grep -q '"labellings_switched":[1-9]' boxplain.model.log.jsonl && fail "plain MSE switched labellings"
+
 # expect_error NAME TEXT ARGS...: exit 2, one stderr line containing TEXT, no model written.
 expect_error() {
   local name=$1 text=$2; shift 2
@@ -100,6 +116,7 @@ camera=$(find bop -name scene_camera.json | head -1)
 im_id=$((10#$(basename "$depth" .png)))
 expect_error frame_no_gt "no ground-truth pose" "$MUG" --depth "$depth" --mask "$mask" --camera "$camera" --im-id $im_id
 expect_error copy_noise "--copy-noise" "$MUG" --bop bop --obj-id 4 --copy-noise lots
+expect_error symmetry_tolerance "--symmetry-tolerance" "$BOX" --data boxsim --symmetry-tolerance lots
 
 [ $failures -eq 0 ] && echo "train_supervised: all checks passed"
 exit $((failures > 0))

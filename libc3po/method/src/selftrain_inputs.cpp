@@ -178,7 +178,7 @@ std::vector<TrainingSample> LabelWithTruth(const UnlabelledClouds& clouds, const
                                                   "scene_gt.json, or a manifest with keypoints)");
     }
     // Label = the keypoints posed at the truth: scene_from_model * keypoints.
-    samples.push_back({clouds.clouds[i], *clouds.truth[i] * object.keypoints()});
+    samples.push_back({clouds.clouds[i], *clouds.truth[i] * object.keypoints(), {}});
   }
   return samples;
 }

@@ -71,6 +71,7 @@ TrainingSample Augment(const TrainingSample& sample, const Augmentation& augment
     const Eigen::Matrix3d R = Eigen::AngleAxisd(rng->Uniform(-limit, limit), Eigen::Vector3d::UnitZ()).toRotationMatrix();
     out.cloud = R * out.cloud;
     out.keypoints = R * out.keypoints;
+    for (PointSet& labelling : out.symmetric_keypoints) labelling = R * labelling;
   }
   if (augmentation.point_dropout > 0.0 && out.cloud.cols() > 1) {
     const double drop = rng->Uniform(0.0, augmentation.point_dropout);

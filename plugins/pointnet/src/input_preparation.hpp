@@ -41,7 +41,7 @@ struct Augmentation {
 };
 
 // A randomly perturbed copy of a training pair: rotation about the sensor's z
-// axis (cloud and keypoints together), dropout of a random fraction in
+// axis (cloud and keypoints, symmetric labellings included, together), dropout of a random fraction in
 // [0, point_dropout] of the points (at least one point stays), Gaussian noise
 // on the cloud.
 TrainingSample Augment(const TrainingSample& sample, const Augmentation& augmentation, Rng* rng);

@@ -18,7 +18,7 @@ json EpochToJson(const EpochLog& log) {
   auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   return {{"epoch", log.epoch}, {"train_loss", number(log.train_loss)},
           {"val_loss", number(log.val_loss)}, {"val_keypoint_error", number(log.val_keypoint_error)},
-          {"seconds", log.seconds}, {"best", log.best}};
+          {"seconds", log.seconds}, {"labellings_switched", log.labellings_switched}, {"best", log.best}};
 }
 
 double NumberOrNaN(const json& value) {
@@ -32,6 +32,7 @@ EpochLog EpochFromJson(const json& j) {
   log.val_loss = NumberOrNaN(j.at("val_loss"));
   log.val_keypoint_error = NumberOrNaN(j.at("val_keypoint_error"));
   log.seconds = j.at("seconds").get<double>();
+  if (j.contains("labellings_switched")) log.labellings_switched = j.at("labellings_switched").get<int>();
   log.best = j.at("best").get<bool>();
   return log;
 }

@@ -91,6 +91,25 @@ Split SplitSamples(const std::vector<TrainingSample>& train,
   return split;
 }
 
+// Squared distance between two normalised keypoint vectors.
+double SquaredDistance(const tiny_dnn::vec_t& a, const tiny_dnn::vec_t& b) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) sum += static_cast<double>(a[i] - b[i]) * static_cast<double>(a[i] - b[i]);
+  return sum;
+}
+
+// Index into {keypoints, symmetric_keypoints...} of the labelling nearest
+// `detected` (0 = keypoints; ties keep the lower index).
+std::size_t NearestLabellingIndex(const PointSet& detected, const TrainingSample& sample) {
+  std::size_t best = 0;
+  double best_distance = (detected - sample.keypoints).squaredNorm();
+  for (std::size_t j = 0; j < sample.symmetric_keypoints.size(); ++j) {
+    const double distance = (detected - sample.symmetric_keypoints[j]).squaredNorm();
+    if (distance < best_distance) best = j + 1, best_distance = distance;
+  }
+  return best;
+}
+
 }  // namespace
 
 // One optimisation step on prepared inputs; returns the loss before the step
@@ -102,6 +121,32 @@ static double StepOnPrepared(PointNetDetector::Impl* impl, const tiny_dnn::tenso
   impl->network->Update(impl->optimizer.get(), static_cast<int>(inputs.size()));
   impl->WeightsChanged();
   return loss;
+}
+
+// Symmetry-aware loss min_j ||ỹ - y_j||² (method.md "Symmetric labellings in
+// supervised training"): where a sample has symmetric labellings, its target
+// becomes the labelling nearest the network's current output on the same
+// input. Returns how many targets changed. No forward pass when no sample has
+// symmetric labellings (the plain loss, bit for bit).
+static int ChooseNearestTargets(PointNetDetector::Impl* impl, const tiny_dnn::tensor_t& inputs,
+                                const std::vector<tiny_dnn::tensor_t>& symmetric_targets,
+                                tiny_dnn::tensor_t* targets) {
+  if (std::all_of(symmetric_targets.begin(), symmetric_targets.end(),
+                  [](const tiny_dnn::tensor_t& t) { return t.empty(); })) {
+    return 0;
+  }
+  const tiny_dnn::tensor_t outputs = impl->network->Forward(inputs);
+  int switched = 0;
+  for (std::size_t i = 0; i < symmetric_targets.size(); ++i) {
+    double best = SquaredDistance(outputs[i], (*targets)[i]);
+    const tiny_dnn::vec_t* chosen = nullptr;
+    for (const tiny_dnn::vec_t& labelling : symmetric_targets[i]) {
+      const double distance = SquaredDistance(outputs[i], labelling);
+      if (distance < best) best = distance, chosen = &labelling;
+    }
+    if (chosen) (*targets)[i] = *chosen, ++switched;
+  }
+  return switched;
 }
 
 double PointNetDetector::TrainStep(const std::vector<PointSet>& clouds,
@@ -150,7 +195,10 @@ PointNetDetector::Evaluation PointNetDetector::Evaluate(const std::vector<Traini
   double squared = 0.0, distance = 0.0;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     CheckKeypointCount(samples[i].keypoints, impl_->identity.num_keypoints);
-    const Eigen::VectorXd d = (detected[i] - samples[i].keypoints).colwise().norm();
+    // Symmetric labellings: the error to the nearest one (the loss trained).
+    const std::size_t nearest = NearestLabellingIndex(detected[i], samples[i]);
+    const PointSet& truth = nearest == 0 ? samples[i].keypoints : samples[i].symmetric_keypoints[nearest - 1];
+    const Eigen::VectorXd d = (detected[i] - truth).colwise().norm();
     squared += d.squaredNorm() / static_cast<double>(d.size());
     distance += d.mean();
   }
@@ -212,20 +260,27 @@ PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train
     Rng shuffle_rng(epoch_seed);
     const std::vector<std::size_t> order = Shuffled(split.train.size(), &shuffle_rng);
     double loss_sum = 0.0;
+    int switched = 0;
     for (std::size_t begin = 0; begin < order.size(); begin += static_cast<std::size_t>(options.batch)) {
       HoldForInterruptAt(epoch, static_cast<long long>(begin / static_cast<std::size_t>(options.batch)));
       ThrowIfInterrupted();
       const std::size_t count = std::min(order.size() - begin, static_cast<std::size_t>(options.batch));
       tiny_dnn::tensor_t inputs(count), targets(count);
+      std::vector<tiny_dnn::tensor_t> symmetric_targets(count);
       ParallelFor(0, static_cast<int>(count), [&](int i) {
         const std::size_t position = begin + static_cast<std::size_t>(i);
         Rng rng = Rng::ForItem(epoch_seed, position);
         const TrainingSample& original = *split.train[order[position]];
         const TrainingSample sample = augmentation.active() ? pointnet::Augment(original, augmentation, &rng) : original;
         auto prepared = pointnet::PrepareCloud(sample.cloud, num_points, scale, &rng);
-        targets[static_cast<std::size_t>(i)] = pointnet::NormaliseKeypoints(sample.keypoints, prepared.centroid, scale);
-        inputs[static_cast<std::size_t>(i)] = std::move(prepared.points);
+        const std::size_t s = static_cast<std::size_t>(i);
+        targets[s] = pointnet::NormaliseKeypoints(sample.keypoints, prepared.centroid, scale);
+        for (const PointSet& labelling : sample.symmetric_keypoints) {
+          symmetric_targets[s].push_back(pointnet::NormaliseKeypoints(labelling, prepared.centroid, scale));
+        }
+        inputs[s] = std::move(prepared.points);
       }, impl.threads);
+      switched += ChooseNearestTargets(&impl, inputs, symmetric_targets, &targets);
       loss_sum += StepOnPrepared(&impl, inputs, targets) * static_cast<double>(count);
     }
     EpochLog log;
@@ -241,6 +296,7 @@ PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train
       impl.progress.best_weights = impl.network->Weights();
     }
     log.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    log.labellings_switched = switched;
     impl.progress.epochs_done = epoch;
     impl.progress.history.push_back(log);
     if (!options.checkpoint_path.empty()) SaveCheckpoint(options.checkpoint_path, "");

@@ -22,9 +22,14 @@ class Detector {
 };
 
 // A (cloud, keypoints) training pair; keypoints are posed, 3 x N.
+// symmetric_keypoints: other labellings equally right for the cloud (the
+// keypoints turned by a symmetry of the object, model_symmetries.hpp);
+// supervised training then regresses onto the labelling nearest the output
+// (the loss min over all labellings), not onto `keypoints` alone.
 struct TrainingSample {
   PointSet cloud;
   PointSet keypoints;
+  std::vector<PointSet> symmetric_keypoints;
 };
 
 // A detector that can be trained by regression onto target keypoints (used by

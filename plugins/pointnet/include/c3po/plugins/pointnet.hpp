@@ -98,6 +98,7 @@ struct EpochLog {
   double val_loss = 0.0;                     // same on the validation set (NaN if none)
   double val_keypoint_error = 0.0;           // mean keypoint distance, object units (NaN if none)
   double seconds = 0.0;                      // wall time of the epoch
+  int labellings_switched = 0;               // samples trained on a symmetric labelling, not `keypoints`
   bool best = false;                         // best validation loss so far (weights kept)
 };
 
