@@ -41,6 +41,7 @@ struct EvalCommand {
   ThresholdFlags thresholds;
   CorrectorFlags corrector;
   RobustFlags robust;
+  SymmetryFlags symmetry;      // errors to the nearest symmetric truth
   bool no_icp = false;
   bool no_ransac = false;
   std::string ransac_threshold = "5%d";
@@ -233,7 +234,7 @@ int Run(const EvalCommand& cmd) {
       std::cerr << "c3po eval: d = " << diameter << " (diameter of obj_id " << cmd.bop.options.obj_id << " in " << models_info << ")\n";
     }
   }
-  const EvaluationOptions options = MakeOptions(cmd, object, diameter);
+  EvaluationOptions options = MakeOptions(cmd, object, diameter);
   if (cmd.views < 0) throw InputError("--views must be >= 0");
   const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
   const std::string empty_part = "this part holds no clouds (choose N at most the number of " +
@@ -270,6 +271,10 @@ int Run(const EvalCommand& cmd) {
   for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});
   std::vector<TrainingLog> logs;
   if (!cmd.report_path.empty()) logs = ReadTrainingLogs(cmd, loaded);   // fail before the long work
+  for (const ModelSymmetry& symmetry :
+       ObjectSymmetries(cmd.symmetry, object, "rotation and translation errors to the nearest symmetric truth")) {
+    options.symmetries.push_back(symmetry.model_from_model);
+  }
 
   ProgressBar progress("eval", dataset.entries.size());
   Evaluation evaluation =
@@ -327,6 +332,9 @@ RunFunction SetupEval(CLI::App& command) {
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kRefused);
   AddCorrectorOptions(command, &cmd->corrector);
   AddRobustOptions(command, &cmd->robust);
+  AddSymmetryOptions(command, &cmd->symmetry, "--no-symmetric-errors",
+                     "Rotation and translation errors to the truth alone, even for a symmetric object (default: "
+                     "to the nearest of the truth and its symmetric poses)");
   command.add_flag("--no-icp", cmd->no_icp, "Skip the KeyPo + ICP and KeyPo + RANSAC + ICP rows");
   command.add_flag("--no-ransac", cmd->no_ransac, "Skip the KeyPo + RANSAC + ICP rows");
   command.add_option("--ransac-threshold", cmd->ransac_threshold,

@@ -1,6 +1,7 @@
 // Shared command-line options (options.hpp).
 #include "options.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -163,6 +164,32 @@ std::unique_ptr<Detector> MakeDetector(const std::string& model, const std::stri
   if (!model.empty()) return LoadDetectorModel(model, object);
   if (detector == kManifestDetector) return nullptr;
   return CreateDetector(detector, object);
+}
+
+void AddSymmetryOptions(CLI::App& command, SymmetryFlags* flags, const std::string& off_flag,
+                        const std::string& off_help) {
+  command.add_flag("!" + off_flag, flags->enabled, off_help);
+  command.add_option("--symmetry-tolerance", flags->tolerance,
+                     "A rotation moving the model surface by at most this Hausdorff distance is a symmetry "
+                     "(a distance, or e.g. 0.5%d of the diameter; default eps_oc/4)");
+}
+
+std::vector<ModelSymmetry> ObjectSymmetries(const SymmetryFlags& flags, const ObjectModel& object,
+                                            const std::string& use) {
+  if (!flags.enabled) return {};
+  SymmetrySearchOptions options;
+  options.tolerance = flags.tolerance.empty()
+                          ? 0.25 * object.spec().eps_oc
+                          : ParseThreshold(flags.tolerance, object.diameter(), "--symmetry-tolerance");
+  const std::vector<ModelSymmetry> symmetries = FindModelSymmetries(object, options);
+  std::fprintf(stderr, "%s: %zu symmetr%s within %.3g (surface Hausdorff)%s%s\n", object.name().c_str(),
+               symmetries.size(), symmetries.size() == 1 ? "y" : "ies", options.tolerance,
+               symmetries.empty() ? "" : ": ", symmetries.empty() ? "" : use.c_str());
+  for (const ModelSymmetry& s : symmetries) {
+    std::fprintf(stderr, "  %6.1f deg about (%+.3f, %+.3f, %+.3f), Hausdorff %.3g\n", s.angle * 180.0 / M_PI,
+                 s.axis.x(), s.axis.y(), s.axis.z(), s.hausdorff);
+  }
+  return symmetries;
 }
 
 void AddSeedOption(CLI::App& command, std::uint64_t* seed, const std::string& what) {

@@ -19,6 +19,7 @@
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"
 #include "c3po/method/detector.hpp"
+#include "c3po/method/model_symmetries.hpp"
 #include "c3po/method/selftrain_inputs.hpp"
 #include "c3po/object/object_model.hpp"
 
@@ -144,6 +145,20 @@ void AddCameraCloudOptions(CLI::App& command, CameraCloudFlags* flags, const std
 
 // --shard K/N ("" = the whole run); ParseShard (c3po/io/shard.hpp) resolves it.
 void AddShardOption(CLI::App& command, std::string* shard, const std::string& what);
+
+// --no-symmetry-aware-* / --symmetry-tolerance: the object's rotational
+// symmetries (method/model_symmetries.hpp), used by train (loss) and eval
+// (errors to the nearest symmetric truth).
+struct SymmetryFlags {
+  bool enabled = true;
+  std::string tolerance;    // distance or fraction of d; "" = the object's eps_oc / 4
+};
+void AddSymmetryOptions(CLI::App& command, SymmetryFlags* flags, const std::string& off_flag,
+                        const std::string& off_help);
+// The symmetries (none when disabled), listed on stderr with their evidence
+// as "<object>: N symmetries within TOL ...". InputError on a bad tolerance.
+std::vector<ModelSymmetry> ObjectSymmetries(const SymmetryFlags& flags, const ObjectModel& object,
+                                            const std::string& use);
 
 void AddSeedOption(CLI::App& command, std::uint64_t* seed, const std::string& what);
 void AddThreadsOption(CLI::App& command, int* threads, const std::string& what);

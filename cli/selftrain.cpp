@@ -134,6 +134,11 @@ int Run(SelftrainCommand cmd) {
   if (data.AllHaveTruth() && !mixed) {
     reference.emplace();
     for (const auto& truth : data.truth) reference->scene_from_model.push_back(*truth);
+    // Reported rotation errors do not count the object's symmetries.
+    const SymmetryFlags flags{true, cmd.symmetry_tolerance};
+    for (const ModelSymmetry& s : ObjectSymmetries(flags, object, "reported rotation errors to the nearest symmetric truth")) {
+      reference->symmetries.push_back(s.model_from_model);
+    }
   }
   std::string eps_oc_evidence;
   if (cmd.thresholds.auto_eps_oc()) {

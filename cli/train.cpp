@@ -12,7 +12,6 @@
 
 #include "c3po/base/error.hpp"
 #include "c3po/io/dataset.hpp"
-#include "c3po/method/model_symmetries.hpp"
 #include "c3po/method/selftrain_inputs.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/pointnet.hpp"
@@ -36,8 +35,7 @@ struct TrainCommand {
   bool resume = false;
   std::string init_path;                  // --init MODEL: fine-tune from its weights
   CameraCloudFlags camera;                // --bop / --depth,--mask (with ground truth)
-  bool symmetry_aware = true;             // train symmetric objects against min over labellings
-  std::string symmetry_tolerance;         // distance or fraction of d; "" = eps_oc / 4
+  SymmetryFlags symmetry;                 // train symmetric objects against min over labellings
   // Options whose value the architecture of --init fixes (given = refused if different).
   CLI::Option* points_flag = nullptr;
   CLI::Option* point_mlp_flag = nullptr;
@@ -82,25 +80,6 @@ Dataset ReadLabelled(const std::string& dir, int num_keypoints) {
     }
   }
   return dataset;
-}
-
-// The symmetries of the object (none with --no-symmetry-aware-loss); printed
-// with their evidence.
-std::vector<ModelSymmetry> ObjectSymmetries(const TrainCommand& cmd, const ObjectModel& object) {
-  if (!cmd.symmetry_aware) return {};
-  SymmetrySearchOptions options;
-  options.tolerance = cmd.symmetry_tolerance.empty()
-                          ? 0.25 * object.spec().eps_oc
-                          : ParseThreshold(cmd.symmetry_tolerance, object.diameter(), "--symmetry-tolerance");
-  const std::vector<ModelSymmetry> symmetries = FindModelSymmetries(object, options);
-  std::fprintf(stderr, "%s: %zu symmetr%s within %.3g (surface Hausdorff)%s\n", object.name().c_str(),
-               symmetries.size(), symmetries.size() == 1 ? "y" : "ies", options.tolerance,
-               symmetries.empty() ? "" : ": trained against the nearest of the symmetric labellings");
-  for (const ModelSymmetry& s : symmetries) {
-    std::fprintf(stderr, "  %6.1f deg about (%+.3f, %+.3f, %+.3f), Hausdorff %.3g\n", s.angle * 180.0 / M_PI,
-                 s.axis.x(), s.axis.y(), s.axis.z(), s.hausdorff);
-  }
-  return symmetries;
 }
 
 int Run(TrainCommand cmd) {
@@ -167,7 +146,8 @@ int Run(TrainCommand cmd) {
     train = std::move(kept);
   }
 
-  const std::vector<ModelSymmetry> symmetries = ObjectSymmetries(cmd, object);
+  const std::vector<ModelSymmetry> symmetries =
+      ObjectSymmetries(cmd.symmetry, object, "trained against the nearest of the symmetric labellings");
   for (auto* samples : {&train, &validation}) {
     for (TrainingSample& sample : *samples) {
       sample.symmetric_keypoints = SymmetricLabellings(object, symmetries, sample.keypoints);
@@ -233,12 +213,9 @@ RunFunction SetupTrain(CLI::App& command) {
   command.add_option("--noise", o.noise_sigma, "Augmentation: Gaussian noise sigma (object units)");
   cmd->point_mlp_flag = command.add_option("--point-mlp", cmd->point_mlp, "Widths of the shared point MLP")->delimiter(',');
   cmd->head_flag = command.add_option("--head", cmd->head, "Widths of the hidden head layers")->delimiter(',');
-  command.add_flag("!--no-symmetry-aware-loss", cmd->symmetry_aware,
-                   "Plain mean squared error even for a symmetric object (default: the object's rotational "
-                   "symmetries are found and each cloud is trained against the nearest of its labellings)");
-  command.add_option("--symmetry-tolerance", cmd->symmetry_tolerance,
-                     "A rotation moving the model surface by at most this Hausdorff distance is a symmetry "
-                     "(a distance, or e.g. 0.5%d of the diameter; default eps_oc/4)");
+  AddSymmetryOptions(command, &cmd->symmetry, "--no-symmetry-aware-loss",
+                     "Plain mean squared error even for a symmetric object (default: the object's rotational "
+                     "symmetries are found and each cloud is trained against the nearest of its labellings)");
   command.add_flag("--resume", cmd->resume, "Continue from OUTPUT.ckpt (same result as an uninterrupted run)");
   command.add_option("--init", cmd->init_path,
                      "Fine-tune from this model's weights (its architecture; epoch 0 = the model, kept unless beaten)");

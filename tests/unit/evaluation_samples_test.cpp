@@ -30,6 +30,10 @@ EvaluationOptions Options() {
   o.ransac.inlier_threshold = 0.0123456789;
   o.ransac.seed = 42;
   o.worst_listed = 3;
+  Pose symmetry;   // carried bit for bit (the merged table names it)
+  symmetry.R = Eigen::AngleAxisd(M_PI, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  symmetry.t = Eigen::Vector3d(0.01, -0.02, 0.03) / 3.0;
+  o.symmetries = {symmetry};
   return o;
 }
 
@@ -86,15 +90,6 @@ Evaluation Slice(const std::vector<std::vector<SampleResult>>& all, std::size_t 
   return e;
 }
 
-nlohmann::json WithoutMs(const std::string& text) {
-  nlohmann::json j = nlohmann::json::parse(text);
-  for (auto& row : j["rows"]) {
-    if (!row.contains("samples")) continue;
-    for (auto& s : row["samples"]) s.erase("ms");
-  }
-  return j;
-}
-
 std::string ErrorOf(const std::vector<std::pair<std::string, std::string>>& parts) {
   try {
     MergeEvaluationSamples(parts);
@@ -123,6 +118,9 @@ TEST_CASE("merged sample files of contiguous parts give the whole evaluation's t
     CHECK(IsEvaluationSamples(parts.front().second));
     const Evaluation merged = MergeEvaluationSamples(parts);
     CHECK(EvaluationTable(merged) == EvaluationTable(whole));
+    REQUIRE(merged.options.symmetries.size() == 1);
+    CHECK(merged.options.symmetries[0].R == whole.options.symmetries[0].R);
+    CHECK(merged.options.symmetries[0].t == whole.options.symmetries[0].t);
     CHECK(EvaluationJson(merged) == EvaluationJson(whole));   // even the timings: they are carried exactly
     REQUIRE(merged.rows.size() == whole.rows.size());
     for (std::size_t r = 0; r < merged.rows.size(); ++r) {
@@ -162,6 +160,11 @@ TEST_CASE("merge --eval refuses parts out of order, missing, of another run, tru
   std::string swapped = b;   // a sample out of dataset order
   swapped.replace(swapped.find("\"index\":0"), 9, "\"index\":3");
   CHECK(ErrorOf({{"a", a}, {"s", swapped}}).find("index 3: expected 0") != std::string::npos);
+  std::string bad_symmetry = b;   // a symmetry that is not 12 numbers
+  const std::size_t at = bad_symmetry.find("\"symmetries\":[[");
+  REQUIRE(at != std::string::npos);
+  bad_symmetry.replace(at, 16, "\"symmetries\":[[1],[");
+  CHECK(ErrorOf({{"a", a}, {"y", bad_symmetry}}).find("y: line 1: symmetries: each pose is 12 numbers") != std::string::npos);
   CHECK_FALSE(IsEvaluationSamples("{\"cloud\": \"x.ply\"}\n"));
   CHECK(ErrorOf({}) == "c3po merge: no parts");
 }

@@ -1,6 +1,8 @@
 // Evaluation of the paper's table rows on a dataset with ground truth.
 #include "c3po/eval/evaluation.hpp"
 
+#include "c3po/method/model_symmetries.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,6 +14,7 @@
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/certify_batch.hpp"
 #include "c3po/method/keypoint_ransac.hpp"
+#include "c3po/method/model_symmetries.hpp"
 #include "c3po/method/pipeline.hpp"
 
 namespace c3po {
@@ -47,8 +50,9 @@ void ScoreAgainstTruth(const ObjectModel& object, const Pose& truth, const Evalu
     return;
   }
   sample->adds = AddS(object.tree(), truth, sample->scene_from_model, options.adds_variant);
-  sample->rotation_error = RotationError(sample->scene_from_model.R, truth.R);
-  sample->translation_error = TranslationError(sample->scene_from_model.t, truth.t);
+  const Pose nearest = NearestSymmetricTruth(truth, sample->scene_from_model, options.symmetries);
+  sample->rotation_error = RotationError(sample->scene_from_model.R, nearest.R);
+  sample->translation_error = TranslationError(sample->scene_from_model.t, nearest.t);
   if (sample->certified()) {
     sample->hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000), truth,
                                             sample->scene_from_model);
@@ -216,6 +220,9 @@ void EvaluationOptions::Check() const {
     throw std::invalid_argument("EvaluationOptions: auc_max must be positive and finite");
   }
   if (worst_listed < 0) throw std::invalid_argument("EvaluationOptions: worst_listed must be >= 0");
+  for (const Pose& symmetry : symmetries) {
+    if (!symmetry.IsFinite()) throw std::invalid_argument("EvaluationOptions: non-finite symmetry");
+  }
   pipeline.Check();
   if (run_icp) icp.Check();
   if (run_icp && run_ransac) ransac.Check();

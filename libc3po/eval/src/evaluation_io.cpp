@@ -57,6 +57,10 @@ std::string SettingsLines(const Evaluation& e) {
   std::ostringstream out;
   out << "Columns: ADD-S % = threshold score, AUC = ADD-S AUC (0..100), rot err and t err / d = medians, "
          "% oc / % nd / % cert = certificate rates, false cert = certified with ADD-S >= threshold.\n";
+  if (!o.symmetries.empty()) {
+    out << "Rotation and translation errors: to the nearest of the truth and its " << o.symmetries.size()
+        << " symmetric pose" << (o.symmetries.size() == 1 ? "" : "s") << " (the object's symmetries).\n";
+  }
   char line[512];
   std::snprintf(line, sizeof line,
                 "ADD-S variant: %s. Threshold score: ADD-S < %.6g (%s); AUC on [0, %.6g] (%s); d = %.6g.\n",
@@ -223,6 +227,7 @@ std::string EvaluationJson(const Evaluation& e) {
   j["clouds"] = e.clouds;
   j["diameter"] = e.diameter;
   j["adds_variant"] = ToString(o.adds_variant);
+  j["symmetries"] = o.symmetries.size();
   j["adds_threshold"] = o.adds_threshold;
   j["adds_threshold_fraction_of_d"] = o.adds_threshold / e.diameter;
   j["auc_max"] = o.auc_max;

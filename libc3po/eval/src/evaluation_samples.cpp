@@ -94,7 +94,32 @@ json SettingsJson(const EvaluationOptions& o) {
   s["ransac_max_iterations"] = o.ransac.max_iterations;
   s["ransac_seed"] = o.ransac.seed;
   s["worst_listed"] = o.worst_listed;
+  json symmetries = json::array();
+  for (const Pose& symmetry : o.symmetries) {
+    json pose = json::array();
+    for (int i = 0; i < 9; ++i) pose.push_back(Exact(symmetry.R(i / 3, i % 3)));
+    for (int i = 0; i < 3; ++i) pose.push_back(Exact(symmetry.t(i)));
+    symmetries.push_back(pose);
+  }
+  s["symmetries"] = symmetries;
   return s;
+}
+
+// "symmetries": [[R row-major (9), t (3)], ...]; absent in files written
+// before it existed (= none). At most 64.
+std::vector<Pose> SymmetriesFromSettings(const json& s, const std::string& where) {
+  std::vector<Pose> symmetries;
+  const auto it = s.find("symmetries");
+  if (it == s.end()) return symmetries;
+  if (!it->is_array() || it->size() > 64) throw InputError(where, "symmetries: expected an array of at most 64 poses");
+  for (const json& pose : *it) {
+    if (!pose.is_array() || pose.size() != 12) throw InputError(where, "symmetries: each pose is 12 numbers (R, t)");
+    Pose symmetry;
+    for (int i = 0; i < 9; ++i) symmetry.R(i / 3, i % 3) = ReadExact(pose[static_cast<std::size_t>(i)], where, "symmetries");
+    for (int i = 0; i < 3; ++i) symmetry.t(i) = ReadExact(pose[static_cast<std::size_t>(9 + i)], where, "symmetries");
+    symmetries.push_back(symmetry);
+  }
+  return symmetries;
 }
 
 // The options the table and JSON show, back from SettingsJson (the rest keep
@@ -132,6 +157,7 @@ EvaluationOptions OptionsFromSettings(const json& s, const std::string& where) {
                       ? Field(s, "ransac_seed", where).get<std::uint64_t>()
                       : throw InputError(where, "ransac_seed: expected an unsigned integer");
   o.worst_listed = static_cast<int>(Integer(s, "worst_listed", where, 0, 1 << 30));
+  o.symmetries = SymmetriesFromSettings(s, where);
   try {
     o.Check();
   } catch (const std::invalid_argument& e) {

@@ -153,4 +153,15 @@ std::vector<PointSet> SymmetricLabellings(const ObjectModel& object, const std::
   return labellings;
 }
 
+Pose NearestSymmetricTruth(const Pose& truth, const Pose& estimate, const std::vector<Pose>& symmetries) {
+  Pose nearest = truth;
+  double best = (estimate.R.transpose() * truth.R).trace();
+  for (const Pose& symmetry : symmetries) {
+    const Pose candidate = truth * symmetry;
+    const double trace = (estimate.R.transpose() * candidate.R).trace();
+    if (trace > best) best = trace, nearest = candidate;
+  }
+  return nearest;
+}
+
 }  // namespace c3po

@@ -1,5 +1,7 @@
 #include "c3po/method/selftrain.hpp"
 
+#include "c3po/method/model_symmetries.hpp"
+
 #include <algorithm>
 #include <cstring>
 #include <atomic>
@@ -16,6 +18,7 @@
 #include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
 #include "c3po/base/parallel.hpp"
+#include "c3po/method/model_symmetries.hpp"
 #include "c3po/base/random.hpp"
 #include "c3po/geometry/distances.hpp"
 #include "c3po/method/selftrain_inputs.hpp"
@@ -92,7 +95,8 @@ double RotationAngleDegrees(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) 
 
 ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<PointSet>& clouds,
                                    const Detector& detector, const PipelineOptions& pipeline,
-                                   const PseudoLabelOptions& pseudo_labels, const std::vector<Pose>* truth) {
+                                   const PseudoLabelOptions& pseudo_labels, const std::vector<Pose>* truth,
+                                   const std::vector<Pose>& symmetries) {
   ValidationFit fit;
   if (clouds.empty()) return fit;
   const CertifiedFraction measured = MeasureCertified(object, clouds, detector, pipeline);
@@ -128,7 +132,7 @@ ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<
     std::vector<double> rotation, hausdorff;
     for (std::size_t i = 0; i < clouds.size(); ++i) {
       const Pose& estimate = measured.estimates[i].scene_from_model;
-      rotation.push_back(RotationAngleDegrees((*truth)[i].R, estimate.R));
+      rotation.push_back(RotationAngleDegrees(NearestSymmetricTruth((*truth)[i], estimate, symmetries).R, estimate.R));
       hausdorff.push_back(PosedSurfaceHausdorff(object, queries, (*truth)[i], estimate));
     }
     fit.rotation_error_median = Quantile(rotation, 0.5);
@@ -324,7 +328,8 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   const std::vector<Pose>* truth = reference != nullptr ? &validation_truth : nullptr;
   const std::vector<int> train(all.begin() + static_cast<long>(validation_count), all.end());
   const auto measure = [&] {
-    return MeasureValidationFit(object, validation, detector, options.pipeline, options.pseudo_labels, truth);
+    return MeasureValidationFit(object, validation, detector, options.pipeline, options.pseudo_labels, truth,
+                                reference != nullptr ? reference->symmetries : std::vector<Pose>{});
   };
 
   SelfTrainResult result;

@@ -16,7 +16,8 @@
 // (all clouds; the observably correct ones; the certified ones).
 //
 // Per sample: ADD-S (the variant is part of the options and named in every
-// output), rotation error, translation error. A pose that could not be
+// output), rotation error, translation error (to the nearest symmetric truth
+// when the options list the object's symmetries). A pose that could not be
 // estimated (unreadable cloud, detector failure, degenerate keypoints) counts
 // as a failure: ADD-S = +inf, rotation error = pi, translation error = +inf,
 // oc = nd = 0.
@@ -49,6 +50,12 @@ struct EvaluationOptions {
   bool run_ransac = true;          // false: no "+ RANSAC + ICP" rows
   KeypointRansacOptions ransac;    // Defaults: inlier threshold 5 % of d
   int worst_listed = 5;            // false certificates listed per row
+  // Rotational symmetries of the object (model_from_model, e.g. from
+  // FindModelSymmetries): rotation and translation errors are measured to
+  // the nearest of the truth T* and the symmetric truths T*·S (the one with
+  // the smallest rotation error); empty = to T* alone. ADD-S and the
+  // Hausdorff check need none (distances between posed shapes).
+  std::vector<Pose> symmetries;
   void Check() const;              // throws std::invalid_argument
   // Paper defaults: thresholds 5 % and 10 % of d; certificate thresholds of the object.
   static EvaluationOptions Defaults(const ObjectModel& object);

@@ -50,4 +50,11 @@ std::vector<ModelSymmetry> FindModelSymmetries(const ObjectModel& object, const 
 std::vector<PointSet> SymmetricLabellings(const ObjectModel& object, const std::vector<ModelSymmetry>& symmetries,
                                           const PointSet& posed_keypoints);
 
+// The truth among T* and T*·S (S in `symmetries`, model_from_model) whose
+// rotation is nearest the estimate's (largest tr(R̂ᵀ R), i.e. smallest
+// angle; T* on ties): pose errors measured to it do not count a symmetry of
+// the object as an error (eval's rotation and translation errors, the
+// self-training log's rotation error).
+Pose NearestSymmetricTruth(const Pose& truth, const Pose& estimate, const std::vector<Pose>& symmetries);
+
 }  // namespace c3po

@@ -98,6 +98,9 @@ struct SelfTrainResult {
 // never reads it.
 struct SelfTrainReference {
   std::vector<Pose> scene_from_model;
+  // The object's symmetries (model_from_model): the reported rotation error
+  // is to the nearest symmetric truth (NearestSymmetricTruth).
+  std::vector<Pose> symmetries;
 };
 
 // One JSON object with every field of the log (the CLI's epoch-log line).
@@ -123,7 +126,8 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
 ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<PointSet>& clouds,
                                    const Detector& detector, const PipelineOptions& pipeline,
                                    const PseudoLabelOptions& pseudo_labels,
-                                   const std::vector<Pose>* truth = nullptr);
+                                   const std::vector<Pose>* truth = nullptr,
+                                   const std::vector<Pose>& symmetries = {});
 
 // % of clouds whose detector + corrector output is observably correct, and %
 // certified (oc and nd); optionally the mean corrector iterations.
