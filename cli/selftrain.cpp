@@ -131,14 +131,21 @@ int Run(SelftrainCommand cmd) {
   // Another object's truth is not this object's: no reporting columns on a mixed set.
   const bool mixed = std::any_of(data.labels.begin(), data.labels.end(),
                                  [&](const std::string& label) { return !label.empty() && label != object.name(); });
+  // The object's symmetries: labellings T̂·S·b of every certified sample (the
+  // symmetry-aware loss) and reported rotation errors to the nearest
+  // symmetric truth.
+  std::vector<Pose> symmetries;
+  for (const ModelSymmetry& s : ObjectSymmetries(SymmetryFlags{true, cmd.symmetry_tolerance}, object,
+                                                 options.pseudo_labels.symmetry_aware
+                                                     ? "every certified sample trained on its nearest labelling"
+                                                     : "reported rotation errors only (--no-symmetry-aware-loss)")) {
+    symmetries.push_back(s.model_from_model);
+  }
+  if (options.pseudo_labels.symmetry_aware) options.pseudo_labels.model_symmetries = symmetries;
   if (data.AllHaveTruth() && !mixed) {
     reference.emplace();
     for (const auto& truth : data.truth) reference->scene_from_model.push_back(*truth);
-    // Reported rotation errors do not count the object's symmetries.
-    const SymmetryFlags flags{true, cmd.symmetry_tolerance};
-    for (const ModelSymmetry& s : ObjectSymmetries(flags, object, "reported rotation errors to the nearest symmetric truth")) {
-      reference->symmetries.push_back(s.model_from_model);
-    }
+    reference->symmetries = symmetries;
   }
   std::string eps_oc_evidence;
   if (cmd.thresholds.auto_eps_oc()) {

@@ -374,6 +374,18 @@ TEST_CASE("symmetric labellings: an exactly symmetric slab's flips are labelling
     const PseudoLabelCheck refused = CheckPseudoLabel(object, clouds[i], estimate, options.pipeline, refuse, frame);
     CHECK(refused.ambiguous);
     CHECK(refused.symmetric_labellings.empty());
+    // The object's known symmetries add T̂·S·b to the labellings whether or
+    // not a rival fit lands there (exact, from the estimate's pose); not
+    // without the symmetry-aware loss.
+    PseudoLabelOptions known = options.pseudo_labels;
+    known.check_ambiguity = false;   // no rival fits: only the known symmetries
+    known.model_symmetries = {normal_flip, HalfTurn(frame, 0)};
+    const PseudoLabelCheck with_known = CheckPseudoLabel(object, clouds[i], estimate, options.pipeline, known, frame);
+    REQUIRE(with_known.symmetric_labellings.size() == 2);
+    CHECK((with_known.symmetric_labellings[0] - (estimate.scene_from_model * normal_flip) * object.keypoints())
+              .cwiseAbs().maxCoeff() < 1e-12);
+    known.symmetry_aware = false;
+    CHECK(CheckPseudoLabel(object, clouds[i], estimate, options.pipeline, known, frame).symmetric_labellings.empty());
   }
   // The step's target is the labelling nearest the detection.
   const PointSet a = PointSet::Zero(3, 2), b = PointSet::Constant(3, 2, 1.0), c = PointSet::Constant(3, 2, 2.0);

@@ -10,6 +10,9 @@ void PseudoLabelOptions::Check() const {
     throw std::invalid_argument("ambiguity residual ratio must be >= 1");
   }
   if (!std::isfinite(symmetry_tolerance)) throw std::invalid_argument("symmetry tolerance must be finite");
+  for (const Pose& symmetry : model_symmetries) {
+    if (!symmetry.IsFinite()) throw std::invalid_argument("model symmetries must be finite");
+  }
 }
 
 double PseudoLabelOptions::SymmetryTolerance(double eps_oc) const {
@@ -40,6 +43,11 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
                                   const PrincipalFrame& frame) {
   PseudoLabelCheck check;
   check.residual = FitResidual(object, cloud, estimate.scene_from_model);
+  if (options.symmetry_aware && estimate.ok()) {
+    for (const Pose& symmetry : options.model_symmetries) {
+      check.symmetric_labellings.push_back((estimate.scene_from_model * symmetry) * object.keypoints());
+    }
+  }
   if (!options.check_ambiguity || !estimate.ok()) return check;
   const double eps_oc = pipeline.certificate.eps_oc;
   const double symmetry_tolerance = options.SymmetryTolerance(eps_oc);

@@ -23,7 +23,10 @@
 // explanation. It does not make the sample ambiguous; its keypoints are
 // another correct labelling, and the sample is trained on with the
 // symmetry-aware loss min_j ||ỹ - y_j||² over its labellings (the step's
-// target is the labelling nearest the detection, NearestLabelling).
+// target is the labelling nearest the detection, NearestLabelling). The
+// object's known symmetries (model_symmetries) add T̂·S·b to every sample's
+// labellings, so that every sample of a symmetric object is trained with the
+// same loss (a sample trained on y* alone would pull toward the average).
 #include <vector>
 
 #include "c3po/method/global_uniqueness.hpp"
@@ -36,6 +39,10 @@ struct PseudoLabelOptions {
   double residual_ratio = 1.25;   // rival RMS residual <= ratio * chosen => near-equal
   bool symmetry_aware = true;     // symmetric labellings are trained on (min over labellings), not refused
   double symmetry_tolerance = -1.0;   // object units; < 0: SymmetryTolerance() = eps_oc / 4
+  // The object's known symmetries (model_from_model, FindModelSymmetries):
+  // with symmetry_aware, T̂·S·b is a labelling of every certified sample,
+  // whether or not a rival fit lands in that basin.
+  std::vector<Pose> model_symmetries;
   void Check() const;             // ratio >= 1 and finite; tolerance finite
   // The tolerance in force for a certificate's eps_oc.
   double SymmetryTolerance(double eps_oc) const;
