@@ -148,10 +148,19 @@ int Run(TrainCommand cmd) {
 
   const std::vector<ModelSymmetry> symmetries =
       ObjectSymmetries(cmd.symmetry, object, "trained against the nearest of the symmetric labellings");
+  std::size_t labelled = 0, total = 0;
   for (auto* samples : {&train, &validation}) {
     for (TrainingSample& sample : *samples) {
       sample.symmetric_keypoints = SymmetricLabellings(object, symmetries, sample.keypoints);
+      labelled += !sample.symmetric_keypoints.empty();
+      ++total;
     }
+  }
+  if (!symmetries.empty() && labelled < total) {
+    // Labels that are not a rigid copy of the object's keypoints have no pose
+    // to turn: those samples keep the plain loss.
+    std::fprintf(stderr, "c3po train: %zu of %zu clouds have symmetric labellings (the others' keypoints are not "
+                 "a rigid copy of the object's: plain loss)\n", labelled, total);
   }
   if (!detector) detector = std::make_unique<PointNetDetector>(object, architecture, cmd.options.seed);
   EpochLogFile log(cmd.output_path);

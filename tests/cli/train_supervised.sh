@@ -92,6 +92,19 @@ grep -q '"labellings_switched":[1-9]' boxsym.model.log.jsonl || fail "train box:
 "$C3PO" train "$BOX" --data boxsim -o boxplain.model --epochs 2 --point-mlp 16,16 --head 16 --points 64 --seed 1 \
   --no-symmetry-aware-loss > boxplain.out 2> boxplain.err || fail "train box --no-symmetry-aware-loss exited $?"
 grep -q '"symmetries":0' boxplain.model || fail "boxplain.model header: symmetries not 0"
+# A label that is not a rigid copy of the keypoints (one cloud's stretched
+# 1.5x) has no pose to turn: that cloud keeps the plain loss, and train says so.
+cp -r boxsim boxbent
+python3 - boxbent/manifest.jsonl <<'PY' || fail "could not bend a label"
+import json, sys
+path = sys.argv[1]
+lines = [json.loads(l) for l in open(path) if l.strip()]
+lines[0]['keypoints'] = [[1.5 * p[0], p[1], p[2]] for p in lines[0]['keypoints']]
+open(path, 'w').write(''.join(json.dumps(l) + '\n' for l in lines))
+PY
+"$C3PO" train "$BOX" --data boxbent -o boxbent.model --epochs 1 --point-mlp 16,16 --head 16 --points 64 --seed 1 \
+  > boxbent.out 2> boxbent.err || fail "train on a bent label exited $?: $(tail -2 boxbent.err)"
+grep -q "19 of 20 clouds have symmetric labellings" boxbent.err || fail "train bent label: $(grep -v '^  ' boxbent.err | head -4)"
 grep -q '"labellings_switched":[1-9]' boxplain.model.log.jsonl && fail "plain MSE switched labellings"
 
 # expect_error NAME TEXT ARGS...: exit 2, one stderr line containing TEXT, no model written.
