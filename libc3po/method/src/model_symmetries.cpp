@@ -84,15 +84,17 @@ bool SameRotation(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 
 // Candidates whose posed surface is within this fraction of d are polished.
 constexpr double kPolishDistance = 0.1;
+// Sample points of the screening pass and of the ICP polish.
+constexpr int kScreenQueries = 400;
 
 // The principal axes of a finite sample are off by up to a degree or two
 // (the box's: 1.4°), which turns an exact half-turn into a 5 mm misfit. ICP
-// of B̂ onto S·B̂ from S finds the exact symmetry nearby; the polished
+// of B̂ (400 points) onto S·B̂ from S finds the exact symmetry nearby; the polished
 // rotation is kept when its surface distance is smaller.
-void Polish(const ObjectModel& object, const PointSet& queries, ModelSymmetry* symmetry) {
+void Polish(const ObjectModel& object, const PointSet& icp_points, const PointSet& queries, ModelSymmetry* symmetry) {
   IcpOptions options;
   options.max_iterations = 20;
-  const IcpResult icp = RefineIcp(object, queries, symmetry->model_from_model, options);
+  const IcpResult icp = RefineIcp(object, icp_points, symmetry->model_from_model, options);
   if (!icp.ok()) return;
   const double hausdorff = PosedSurfaceHausdorff(object, queries, Pose::Identity(), icp.scene_from_model);
   if (hausdorff < symmetry->hausdorff) {
@@ -107,6 +109,10 @@ std::vector<ModelSymmetry> FindModelSymmetries(const ObjectModel& object, const 
   options.Check();
   const PrincipalFrame frame = SurfacePrincipalFrame(object);
   const PointSet queries = StridedColumns(object.sample(), options.queries);
+  // Screening: a subset's Hausdorff distance never exceeds the full set's,
+  // so a candidate the subset already puts beyond every threshold is out.
+  const PointSet screen = StridedColumns(object.sample(), kScreenQueries);
+  const double screen_threshold = std::max(options.tolerance, kPolishDistance * object.diameter());
   std::vector<Eigen::Matrix3d> tried;
   std::vector<ModelSymmetry> symmetries;
   for (const Eigen::Matrix3d& R : CandidateRotations(frame, options.max_order)) {
@@ -116,8 +122,9 @@ std::vector<ModelSymmetry> FindModelSymmetries(const ObjectModel& object, const 
     ModelSymmetry symmetry;
     symmetry.model_from_model.R = R;
     symmetry.model_from_model.t = frame.centroid - R * frame.centroid;
+    if (PosedSurfaceHausdorff(object, screen, Pose::Identity(), symmetry.model_from_model) > screen_threshold) continue;
     symmetry.hausdorff = PosedSurfaceHausdorff(object, queries, Pose::Identity(), symmetry.model_from_model);
-    if (symmetry.hausdorff <= kPolishDistance * object.diameter()) Polish(object, queries, &symmetry);
+    if (symmetry.hausdorff <= kPolishDistance * object.diameter()) Polish(object, screen, queries, &symmetry);
     const Eigen::AngleAxisd angle_axis(symmetry.model_from_model.R);
     symmetry.angle = angle_axis.angle();
     symmetry.axis = angle_axis.axis();
