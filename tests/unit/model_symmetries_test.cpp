@@ -83,6 +83,34 @@ TEST_CASE("a cuboid with three different sides has exactly the half-turns about 
   CHECK(FindModelSymmetries(cuboid, Tolerance(0.015)).size() == 3);
 }
 
+ObjectModel Prism(const Eigen::Vector3d& size) {
+  ObjectSpec spec;
+  spec.name = "prism";
+  spec.keypoints = test::BoxMesh({0, 0, 0}, size).vertices;
+  spec.eps_oc = 0.006;
+  spec.delta_nd = 0.004;
+  return ObjectModel(spec, test::BoxMesh({0, 0, 0}, size));
+}
+
+TEST_CASE("equal extents: a cube's 23 rotations and a square prism's 7 are found (from the face normals)") {
+  // Analytic: the rotation group of the cube has order 24; of a square
+  // prism 8 (4 about its axis, 4 half-turns about axes across it).
+  const std::vector<ModelSymmetry> cube = FindModelSymmetries(Prism({0.1, 0.1, 0.1}), Tolerance(0.002));
+  CHECK(cube.size() == 23);
+  const std::vector<ModelSymmetry> prism = FindModelSymmetries(Prism({0.1, 0.1, 0.2}), Tolerance(0.002));
+  CHECK(prism.size() == 7);
+  int about_long_axis = 0;
+  for (const ModelSymmetry& s : prism) {
+    CHECK(s.hausdorff <= 0.002);
+    if (std::abs(s.axis.z()) > 0.999) {
+      ++about_long_axis;
+    } else {
+      CHECK(s.angle == doctest::Approx(M_PI).epsilon(1e-3));
+    }
+  }
+  CHECK(about_long_axis == 3);
+}
+
 TEST_CASE("a 64-sided cylinder: its rotations about the axis are symmetries") {
   const ObjectModel can = Cylinder();
   const std::vector<ModelSymmetry> symmetries = FindModelSymmetries(can, Tolerance(0.002));

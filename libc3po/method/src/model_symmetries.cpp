@@ -54,32 +54,106 @@ PrincipalFrame SurfacePrincipalFrame(const ObjectModel& object) {
   return frame;
 }
 
-// Candidate rotations (model frame, about the origin; the caller centres them).
-std::vector<Eigen::Matrix3d> CandidateRotations(const PrincipalFrame& frame, int max_order) {
+// Dominant planar directions of the mesh: triangle normals (n ~ -n) grouped
+// within 2°, weighted by area; the directions holding >= 5 % of the area,
+// largest first, at most `count`. A cube's or a square prism's faces give
+// the axes its principal frame cannot (equal extents leave the principal
+// axes arbitrary in their eigenspace).
+std::vector<Eigen::Vector3d> DominantNormalAxes(const Mesh& mesh, int count) {
+  constexpr int kMaxClusters = 256;
+  const double cos_limit = std::cos(2.0 * M_PI / 180.0);
+  std::vector<Eigen::Vector3d> sums;   // area-weighted, sign-aligned normal sums
+  std::vector<double> weights;
+  double total = 0.0;
+  for (Eigen::Index f = 0; f < mesh.triangles.cols(); ++f) {
+    const Eigen::Vector3d a = mesh.vertices.col(mesh.triangles(0, f));
+    const Eigen::Vector3d cross = (mesh.vertices.col(mesh.triangles(1, f)) - a)
+                                      .cross(mesh.vertices.col(mesh.triangles(2, f)) - a);
+    const double norm = cross.norm();
+    if (!(norm > 0.0)) continue;
+    const double area = 0.5 * norm;
+    const Eigen::Vector3d n = cross / norm;
+    total += area;
+    std::size_t c = 0;
+    for (; c < sums.size(); ++c) {
+      const double dot = n.dot(sums[c].normalized());
+      if (std::abs(dot) >= cos_limit) {
+        sums[c] += (dot >= 0 ? area : -area) * n;
+        weights[c] += area;
+        break;
+      }
+    }
+    if (c == sums.size() && static_cast<int>(sums.size()) < kMaxClusters) {
+      sums.push_back(area * n);
+      weights.push_back(area);
+    }
+  }
+  std::vector<std::size_t> order(sums.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return weights[x] > weights[y]; });
+  std::vector<Eigen::Vector3d> axes;
+  for (std::size_t i : order) {
+    if (static_cast<int>(axes.size()) >= count || weights[i] < 0.05 * total) break;
+    axes.push_back(sums[i].normalized());
+  }
+  return axes;
+}
+
+// Candidate rotations (model frame, about the origin; the caller centres
+// them): by 2πk/n about every axis, and the rotations mapping every frame
+// onto itself (signed permutations of its axes with determinant +1).
+std::vector<Eigen::Matrix3d> CandidateRotations(const std::vector<Eigen::Vector3d>& axes,
+                                                const std::vector<Eigen::Matrix3d>& frames, int max_order) {
   std::vector<Eigen::Matrix3d> candidates;
-  for (int axis = 0; axis < 3; ++axis) {
-    const Eigen::Vector3d u = frame.axes.col(axis).normalized();
+  for (const Eigen::Vector3d& u : axes) {
     for (int n = 2; n <= max_order; ++n) {
       for (int k = 1; k < n; ++k) {
-        candidates.push_back(Eigen::AngleAxisd(2.0 * M_PI * k / n, u).toRotationMatrix());
+        candidates.push_back(Eigen::AngleAxisd(2.0 * M_PI * k / n, u.normalized()).toRotationMatrix());
       }
     }
   }
-  // Signed permutations of the principal axes with determinant +1.
   const int permutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (const auto& p : permutations) {
-    for (int signs = 0; signs < 8; ++signs) {
-      Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-      for (int r = 0; r < 3; ++r) A(r, p[r]) = (signs >> r) & 1 ? -1.0 : 1.0;
-      if (A.determinant() < 0) continue;
-      candidates.push_back(frame.axes * A * frame.axes.transpose());
+  for (const Eigen::Matrix3d& frame : frames) {
+    for (const auto& p : permutations) {
+      for (int signs = 0; signs < 8; ++signs) {
+        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+        for (int r = 0; r < 3; ++r) A(r, p[r]) = (signs >> r) & 1 ? -1.0 : 1.0;
+        if (A.determinant() < 0) continue;
+        candidates.push_back(frame * A * frame.transpose());
+      }
     }
   }
   return candidates;
 }
 
+// The principal axes and frame, plus the dominant normal axes and the
+// frames of their near-orthogonal pairs (within 2°).
+std::vector<Eigen::Matrix3d> CandidateRotations(const ObjectModel& object, const PrincipalFrame& frame,
+                                                int max_order) {
+  std::vector<Eigen::Vector3d> axes = {frame.axes.col(0), frame.axes.col(1), frame.axes.col(2)};
+  std::vector<Eigen::Matrix3d> frames = {frame.axes};
+  const std::vector<Eigen::Vector3d> normals = DominantNormalAxes(object.mesh(), 3);
+  axes.insert(axes.end(), normals.begin(), normals.end());
+  for (std::size_t i = 0; i < normals.size(); ++i) {
+    for (std::size_t j = i + 1; j < normals.size(); ++j) {
+      if (std::abs(normals[i].dot(normals[j])) > std::sin(2.0 * M_PI / 180.0)) continue;
+      Eigen::Matrix3d normal_frame;
+      normal_frame.col(0) = normals[i];
+      normal_frame.col(1) = (normals[j] - normals[j].dot(normals[i]) * normals[i]).normalized();
+      normal_frame.col(2) = normal_frame.col(0).cross(normal_frame.col(1));
+      frames.push_back(normal_frame);
+    }
+  }
+  return CandidateRotations(axes, frames, max_order);
+}
+
+// Two rotations closer than this are one: polishing can leave the same
+// symmetry a fraction of a degree apart from two candidates, and distinct
+// candidates differ by at least 2π(1/7 - 1/8) = 6.4°.
+constexpr double kSameRotation = 3.0 * M_PI / 180.0;
+
 bool SameRotation(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return RotationAngle(a.transpose() * b) < 0.5 * M_PI / 180.0;
+  return RotationAngle(a.transpose() * b) < kSameRotation;
 }
 
 // Candidates whose posed surface is within this fraction of d are polished.
@@ -114,8 +188,8 @@ std::vector<ModelSymmetry> FindModelSymmetries(const ObjectModel& object, const 
   const PointSet screen = StridedColumns(object.sample(), kScreenQueries);
   const double screen_threshold = std::max(options.tolerance, kPolishDistance * object.diameter());
   std::vector<Eigen::Matrix3d> tried;
-  std::vector<ModelSymmetry> symmetries;
-  for (const Eigen::Matrix3d& R : CandidateRotations(frame, options.max_order)) {
+  std::vector<ModelSymmetry> accepted;
+  for (const Eigen::Matrix3d& R : CandidateRotations(object, frame, options.max_order)) {
     if (SameRotation(R, Eigen::Matrix3d::Identity())) continue;
     if (std::any_of(tried.begin(), tried.end(), [&](const Eigen::Matrix3d& s) { return SameRotation(R, s); })) continue;
     tried.push_back(R);
@@ -129,17 +203,20 @@ std::vector<ModelSymmetry> FindModelSymmetries(const ObjectModel& object, const 
     symmetry.angle = angle_axis.angle();
     symmetry.axis = angle_axis.axis();
     if (!(symmetry.hausdorff <= options.tolerance)) continue;
-    // Polishing may land two candidates on the same symmetry: keep it once.
-    const Eigen::Matrix3d& polished = symmetry.model_from_model.R;
-    if (SameRotation(polished, Eigen::Matrix3d::Identity())) continue;
-    const auto same = std::find_if(symmetries.begin(), symmetries.end(), [&](const ModelSymmetry& s) {
-      return SameRotation(polished, s.model_from_model.R);
-    });
-    if (same != symmetries.end()) {
-      if (symmetry.hausdorff < same->hausdorff) *same = symmetry;
-      continue;
+    if (SameRotation(symmetry.model_from_model.R, Eigen::Matrix3d::Identity())) continue;   // polished to identity
+    accepted.push_back(symmetry);
+  }
+  // Polishing may land several candidates on (nearly) the same symmetry:
+  // keep the best fitting of every group within kSameRotation.
+  std::stable_sort(accepted.begin(), accepted.end(),
+                   [](const ModelSymmetry& a, const ModelSymmetry& b) { return a.hausdorff < b.hausdorff; });
+  std::vector<ModelSymmetry> symmetries;
+  for (const ModelSymmetry& symmetry : accepted) {
+    if (std::none_of(symmetries.begin(), symmetries.end(), [&](const ModelSymmetry& kept) {
+          return SameRotation(symmetry.model_from_model.R, kept.model_from_model.R);
+        })) {
+      symmetries.push_back(symmetry);
     }
-    symmetries.push_back(symmetry);
   }
   std::stable_sort(symmetries.begin(), symmetries.end(), [](const ModelSymmetry& a, const ModelSymmetry& b) {
     return a.angle < b.angle - 1e-9;

@@ -9,8 +9,13 @@
 // rotations that map the principal frame onto itself (signed permutations):
 // every symmetry of an object whose principal extents differ is among them
 // (a symmetry preserves the inertia tensor, hence maps each principal axis to
-// ± itself); for equal extents, symmetries about other axes are not found.
-// A continuous symmetry (a can) shows as its rotations of order <= max_order.
+// ± itself). Equal extents leave the principal axes arbitrary in their
+// eigenspace, so the same candidates are also built from the mesh's dominant
+// face-normal directions (>= 5 % of the area each) and the frames of their
+// orthogonal pairs: a cube's 23 and a square prism's 7 are found; an object
+// with equal extents and no dominant flat faces may lose symmetries about
+// other axes. A continuous symmetry (a can) shows as its rotations of order
+// <= max_order.
 //
 // For a cloud of a symmetric object at pose T, the poses T·S give the same
 // surface: its keypoint labels y = T b and y_S = T S b are equally right, and
@@ -38,7 +43,7 @@ struct ModelSymmetry {
   double hausdorff = 0.0;     // PosedSurfaceHausdorff(B, S·B): the evidence
 };
 
-// The symmetries (identity excluded), each rotation once (within 0.5°),
+// The symmetries (identity excluded), each rotation once (within 3°),
 // ordered by angle, then axis.
 std::vector<ModelSymmetry> FindModelSymmetries(const ObjectModel& object, const SymmetrySearchOptions& options);
 
