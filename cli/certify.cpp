@@ -197,16 +197,10 @@ int Run(const CertifyCommand& cmd) {
   options.pipeline.correct = !cmd.no_correct;
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
-  ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
-  // Depth-image / BOP input of an object without indicator sets: the
-  // measured default budget (docs/method.md "Measured on real frames"),
-  // printed in the summary and in every JSON line. Objects with sets keep 0:
-  // nd_m with a percentage budget needs more than m accepted points within
-  // delta_nd of every set keypoint, which small delta_nd cannot supply.
-  if (cmd.robust.max_outliers.empty() && (cmd.frame.given() || !cmd.bop.dir.empty()) &&
-      object.spec().indicator_sets.empty()) {
-    options.pipeline.certificate.max_outliers.fraction = kDepthImageOutlierFraction;
-  }
+  // Camera inputs get the measured defaults (options.hpp InputKind), printed
+  // in the summary and carried by every JSON line.
+  const InputKind input = cmd.frame.given() || !cmd.bop.dir.empty() ? InputKind::kCameraFrames : InputKind::kClouds;
+  ResolveRobust(cmd.robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
   options.auto_eps_oc = cmd.thresholds.auto_eps_oc();
   if (options.auto_eps_oc && !cmd.shard.empty()) {
     throw InputError("--eps-oc", "auto estimates the threshold from all clouds of a run; with --shard give a value");

@@ -53,10 +53,11 @@ void ResolveCorrector(const CorrectorFlags& flags, CorrectorOptions* options) {
 void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_option("--max-outliers", flags->max_outliers,
                      "Outlier budget m of the certificates: a count (10) or a percentage of each cloud's points "
-                     "(2%); default 0 = the paper");
+                     "(2%); default 0 = the paper; certify's depth-image/BOP input of an object without indicator sets: "
+                     "2% (with the free-space test)");
   command.add_option("--robust-loss", flags->robust_loss,
-                     "Robust kernel of the corrector's point-cloud term, truncated at eps_oc: none (default), "
-                     "tls (truncated least squares, GNC) or gm (Geman-McClure)");
+                     "Robust kernel of the corrector's point-cloud term, truncated at eps_oc: none, tls (truncated "
+                     "least squares, GNC) or gm (Geman-McClure); default none, tls for depth-image/BOP input");
   command.add_option("--nd-min-eigenvalue", flags->nd_min_eigenvalue,
                      "Local non-degeneracy threshold on the smallest generalised eigenvalue (data vs model "
                      "point-to-plane information); 0 = local test off");
@@ -77,9 +78,21 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                      "model (default 0.05)");
 }
 
-void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, CorrectorOptions* corrector) {
-  if (!flags.max_outliers.empty()) certificate->max_outliers = ParseOutlierBudget(flags.max_outliers);
-  corrector->robust_loss = ParseRobustLoss(flags.robust_loss);
+void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& object,
+                   CertificateOptions* certificate, CorrectorOptions* corrector) {
+  if (!flags.max_outliers.empty()) {
+    certificate->max_outliers = ParseOutlierBudget(flags.max_outliers);
+  } else {
+    certificate->max_outliers = OutlierBudget{};
+    if (input == InputKind::kCameraFrames && !flags.no_free_space && object.indicator_sets.empty()) {
+      certificate->max_outliers.fraction = kDepthImageOutlierFraction;
+    }
+  }
+  if (!flags.robust_loss.empty()) {
+    corrector->robust_loss = ParseRobustLoss(flags.robust_loss);
+  } else {
+    corrector->robust_loss = input == InputKind::kClouds ? RobustLoss::kNone : kDepthImageRobustLoss;
+  }
   if (!flags.nd_min_eigenvalue.empty()) {
     char* end = nullptr;
     const double value = std::strtod(flags.nd_min_eigenvalue.c_str(), &end);
@@ -129,7 +142,7 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
 std::string RobustCommandLine(const RobustFlags& flags) {
   std::string line;
   if (!flags.max_outliers.empty()) line += " --max-outliers " + flags.max_outliers;
-  if (flags.robust_loss != "none") line += " --robust-loss " + flags.robust_loss;
+  if (!flags.robust_loss.empty()) line += " --robust-loss " + flags.robust_loss;
   if (!flags.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + flags.nd_min_eigenvalue;
   if (flags.no_global_check) line += " --no-global-check";
   if (flags.no_weak_motion_check) line += " --no-weak-motion-check";

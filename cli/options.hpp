@@ -56,8 +56,8 @@ void ResolveCorrector(const CorrectorFlags& flags, CorrectorOptions* options);
 // non-degeneracy threshold. The meaning lives in the library (certificate.hpp,
 // corrector.hpp, local_nondegeneracy.hpp).
 struct RobustFlags {
-  std::string max_outliers;        // "" = the source's default (0 for ready-made clouds)
-  std::string robust_loss = "none";
+  std::string max_outliers;        // "" = the input's default (InputKind below)
+  std::string robust_loss;         // "" = the input's default (InputKind below)
   std::string nd_min_eigenvalue;   // "" = default; 0 = local test off
   bool no_global_check = false;    // --no-global-check: nd without the rival search
   bool reestimate = false;         // --reestimate: restart a refuted estimate at the rival turns
@@ -67,9 +67,27 @@ struct RobustFlags {
   std::string free_space_fraction; // --free-space-fraction ("" = default)
 };
 void AddRobustOptions(CLI::App& command, RobustFlags* flags);
+// What the clouds of a run are; where --max-outliers / --robust-loss are not
+// given it decides the defaults (docs/method.md "Options and defaults"):
+enum class InputKind {
+  kClouds,          // ready-made clouds: the paper, m = 0 and no kernel
+  // Segments cut from camera frames, certified without their frame (eval
+  // --bop, selftrain's camera inputs): kernel kDepthImageRobustLoss, m = 0.
+  kCameraSegments,
+  // Depth frames (certify --depth/--mask, --bop): kernel
+  // kDepthImageRobustLoss and, while the free-space test is on, the budget
+  // kDepthImageOutlierFraction for objects without indicator sets. The budget
+  // was measured sound on real frames only with free space (without it, 8
+  // false certificates of 200: mustard flips); an object with sets keeps 0
+  // (nd_m with a percentage budget needs more than m points within delta_nd
+  // of every set keypoint, which a small delta_nd cannot supply).
+  kCameraFrames,
+};
 // Fills the certificate's budget and local test and the corrector's kernel
-// (InputError naming the option on a bad value).
-void ResolveRobust(const RobustFlags& flags, CertificateOptions* certificate, CorrectorOptions* corrector);
+// (InputError naming the option on a bad value). certify, eval, selftrain
+// and bench share it, so one input gets one set of defaults everywhere.
+void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& object,
+                   CertificateOptions* certificate, CorrectorOptions* corrector);
 // "m = 2%, robust loss = tls, local nd >= 0.02" for the printed summary.
 std::string DescribeRobust(const CertificateOptions& certificate, const CorrectorOptions& corrector);
 // " --max-outliers 2% --robust-loss tls" (the flags given, for a command line).

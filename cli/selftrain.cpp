@@ -108,7 +108,8 @@ int Run(SelftrainCommand cmd) {
   SelfTrainOptions& options = cmd.options;
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
-  ResolveRobust(cmd.robust, &options.pipeline.certificate, &options.pipeline.corrector);
+  ResolveRobust(cmd.robust, cmd.camera.given() ? InputKind::kCameraSegments : InputKind::kClouds, object.spec(),
+                &options.pipeline.certificate, &options.pipeline.corrector);
   if (!cmd.symmetry_tolerance.empty()) {
     options.pseudo_labels.symmetry_tolerance =
         ParseThreshold(cmd.symmetry_tolerance, object.diameter(), "--symmetry-tolerance");

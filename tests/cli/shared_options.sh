@@ -76,5 +76,41 @@ if [ $pointnet -eq 1 ]; then
   [ ! -e self.model ] || fail "selftrain wrote a model after a bad --robust-loss"
 fi
 
+# One input, one set of defaults (options.hpp InputKind): certify's depth
+# frames (BOP here) of an object without indicator sets get m = 2% and the TLS
+# kernel, m = 0 when the free-space test is off or the object has sets;
+# segments certified without their frame (eval --bop, selftrain --bop) get TLS
+# and m = 0; ready-made clouds keep the paper (m = 0, no kernel); a flag wins.
+python3 - "$SRC/tests/fixtures/objects" <<'EOF' || fail "could not write cube_nosets.json"
+import json, os, sys
+spec = json.load(open(os.path.join(sys.argv[1], "cube.json")))
+spec["mesh"] = os.path.join(sys.argv[1], spec["mesh"])
+spec["indicator_sets"] = []
+json.dump(spec, open("cube_nosets.json", "w"))
+EOF
+"$C3PO" synth "$OBJ" -o bop --format bop --count 2 --obj-id 3 --seed 2 --depth-scale 1 >/dev/null 2>&1 || fail "synth --format bop failed"
+NOSETS="$WORK/cube_nosets.json"
+summary() {   # the certify summary's budget and kernel
+  grep -o "m = [^,]*, robust loss = [a-z]*" "$1" | head -1
+}
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
+[ "$(summary c.out)" == "m = 2%, robust loss = tls" ] || fail "certify --bop defaults: '$(summary c.out)'"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --robust-loss none --max-outliers 5 -o c.jsonl > c.out 2>&1 || true
+[ "$(summary c.out)" == "m = 5, robust loss = none" ] || fail "certify --bop with flags: '$(summary c.out)'"
+"$C3PO" certify "$OBJ" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
+[ "$(summary c.out)" == "m = 0, robust loss = tls" ] || fail "certify --bop, object with sets: '$(summary c.out)'"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --no-free-space -o c.jsonl > c.out 2>&1 || true
+[ "$(summary c.out)" == "m = 0, robust loss = tls" ] || fail "certify --bop --no-free-space: '$(summary c.out)'"
+"$C3PO" certify "$NOSETS" --data data --detector svd -o c.jsonl > c.out 2>&1 || true
+[ "$(summary c.out)" == "m = 0, robust loss = none" ] || fail "certify --data defaults: '$(summary c.out)'"
+"$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --no-icp > e.out 2>&1 || fail "eval --bop exited $?: $(tail -1 e.out)"
+grep -q "outlier budget m = 0,.*robust kernel tls" e.out || fail "eval --bop defaults: $(grep 'outlier budget' e.out)"
+"$C3PO" eval "$NOSETS" --data data --detector svd --no-icp > e.out 2>&1 || fail "eval --data exited $?: $(tail -1 e.out)"
+grep -q "outlier budget m = 0,.*robust kernel none" e.out || fail "eval --data defaults: $(grep 'outlier budget' e.out)"
+if [ $pointnet -eq 1 ]; then
+  "$C3PO" selftrain "$NOSETS" --model cube.model --bop bop --obj-id 3 --copies 2 --epochs 1 -o self_bop.model     > s.out 2>&1 || fail "selftrain --bop exited $?: $(tail -1 s.out)"
+  [ "$(summary s.out)" == "m = 0, robust loss = tls" ] || fail "selftrain --bop defaults: '$(summary s.out)'"
+fi
+
 echo "failures: $failures"
 [ $failures -eq 0 ]
