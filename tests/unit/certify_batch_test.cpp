@@ -341,7 +341,7 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "keypoint_distance", "nd_set", "nd_set_distances", "eps_oc", "delta_nd",
                                          "iterations", "cost_before", "cost_after", "status", "restarts_tried",
                                          "restart_axis", "restart_angle_deg", "max_outliers",
-                                         "outliers", "outlier_indices", "outlier_indices_truncated",
+                                         "robust_loss", "robust_scale", "outliers", "outlier_indices", "outlier_indices_truncated",
                                          "distance_quantiles", "max_inlier_distance", "keypoint_support",
                                          "nd_set_support", "nd_sets", "nd_local", "nd_local_eigenvalue",
                                          "nd_local_motion", "nd_local_rank", "nd_local_weak_motions",
@@ -368,6 +368,8 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   const ObservableCorrectness& oc = e.certificate.oc;
   const NonDegeneracy& nd = e.certificate.nd;
   CHECK(j["max_outliers"].get<int>() == oc.max_outliers);
+  CHECK(j["robust_loss"] == "none");
+  CHECK(j["robust_scale"].get<double>() == 0.0);
   CHECK(j["outliers"].get<int>() == oc.outlier_count);
   CHECK(j["outlier_indices"].get<std::vector<int>>() == oc.outlier_indices);
   CHECK(j["outlier_indices_truncated"].get<bool>() == false);
@@ -415,4 +417,16 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   CHECK(k["oc_distance"].is_null());
   CHECK(k["cost_after"].is_null());
   CHECK(CertifyErrorJsonLine("c.ply", "c.ply: cannot open") == R"({"cloud":"c.ply","error":"c.ply: cannot open"})");
+}
+
+TEST_CASE("certify JSON lines: the corrector's robust kernel and its truncation (the certified eps_oc)") {
+  const Fixture f;
+  PipelineOptions options = f.Options().pipeline;
+  options.corrector.robust_loss = RobustLoss::kTruncated;
+  options.certificate.eps_oc *= 0.5;   // the truncation follows the threshold certified, not the file's
+  const PoseEstimate e = EstimateAndCertify(f.object, f.clouds[0], f.detected[0], options);
+  REQUIRE(e.ok());
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(CertifyJsonLine("a.ply", e));
+  CHECK(j["robust_loss"] == "tls");
+  CHECK(j["robust_scale"].get<double>() == options.certificate.eps_oc);
 }

@@ -74,6 +74,8 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   const ObservableCorrectness& oc = e.certificate.oc;
   const NonDegeneracy& nd = e.certificate.nd;
   line["max_outliers"] = oc.max_outliers;
+  line["robust_loss"] = ToString(e.correction.robust_loss);
+  line["robust_scale"] = e.correction.robust_scale;
   line["outliers"] = oc.outlier_count;
   const std::size_t listed = std::min(oc.outlier_indices.size(), kMaxListedOutliers);
   line["outlier_indices"] = std::vector<int>(oc.outlier_indices.begin(), oc.outlier_indices.begin() + listed);

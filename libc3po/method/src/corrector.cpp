@@ -464,6 +464,7 @@ CorrectorResult CorrectKeypoints(const ObjectModel& object, const PointSet& clou
     if (!(resolved.robust_scale > 0)) throw std::invalid_argument("CorrectKeypoints: robust kernel needs eps_oc > 0");
     return CorrectKeypoints(object, cloud, detected_keypoints, resolved);
   }
+  result.robust_loss = options.robust_loss;
   if (options.robust_loss != RobustLoss::kNone) result.robust_scale = options.robust_scale;
   const CorrectorObjectiveTerms start =
       EvaluateCorrectorObjective(object, cloud, detected_keypoints, options);

@@ -129,7 +129,8 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   restart_axis and restart_angle_deg (re-estimation: axis -1 when the
 //   detector's estimate was kept; global_uniqueness.hpp), then the outlier-robust
 //   evidence (docs/method.md "Outlier-robust certificates"): max_outliers (m
-//   for this cloud), outliers (count at >= eps_oc), outlier_indices (the first
+//   for this cloud), robust_loss and robust_scale (the corrector's kernel and
+//   its truncation c, 0 without a kernel), outliers (count at >= eps_oc), outlier_indices (the first
 //   kMaxListedOutliers, ascending), outlier_indices_truncated,
 //   distance_quantiles (50/90/99/100 %, null when not finite),
 //   max_inlier_distance, keypoint_support (per keypoint), nd_set_support (per
