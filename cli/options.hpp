@@ -72,9 +72,11 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags);
 enum class InputKind {
   kClouds,          // ready-made clouds: the paper, m = 0 and no kernel
   // Segments cut from camera frames, certified without their frame (eval
-  // --bop, selftrain's camera inputs): kernel kDepthImageRobustLoss, m = 0.
+  // --bop; selftrain's camera inputs mixed with --data): kernel
+  // kDepthImageRobustLoss, m = 0.
   kCameraSegments,
-  // Depth frames (certify --depth/--mask, --bop): kernel
+  // Depth frames certified with their frame (certify --depth/--mask, --bop;
+  // selftrain's camera inputs alone): kernel
   // kDepthImageRobustLoss and, while the free-space test is on, the budget
   // kDepthImageOutlierFraction for objects without indicator sets. The budget
   // was measured sound on real frames only with free space (without it, 8

@@ -70,8 +70,12 @@ UnlabelledClouds LoadClouds(SelftrainCommand& cmd, const ObjectModel& object) {
   if (!camera.clouds.empty()) {
     // Camera groups come after the dataset's: no two inputs share a group.
     const int offset = data.groups.empty() ? 0 : *std::max_element(data.groups.begin(), data.groups.end()) + 1;
+    // The dataset's clouds have no frame; each camera cloud keeps its own
+    // (the free-space test of its certificates).
+    data.frames.resize(data.clouds.size());
     for (std::size_t i = 0; i < camera.clouds.size(); ++i) {
       data.clouds.push_back(std::move(camera.clouds[i]));
+      data.frames.push_back(camera.frames.empty() ? DepthView{} : camera.frames[i]);
       data.groups.push_back(camera.groups[i] + offset);
       data.truth.push_back(camera.truth[i]);
       data.names.push_back(camera.names[i]);
@@ -108,8 +112,12 @@ int Run(SelftrainCommand cmd) {
   SelfTrainOptions& options = cmd.options;
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
-  ResolveRobust(cmd.robust, cmd.camera.given() ? InputKind::kCameraSegments : InputKind::kClouds, object.spec(),
-                &options.pipeline.certificate, &options.pipeline.corrector);
+  // Camera clouds are certified with their frames (free space), as certify
+  // does; with --data as well, the dataset's clouds have none.
+  const InputKind input = !cmd.camera.given()    ? InputKind::kClouds
+                          : cmd.data_dir.empty() ? InputKind::kCameraFrames
+                                                 : InputKind::kCameraSegments;
+  ResolveRobust(cmd.robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
   if (!cmd.symmetry_tolerance.empty()) {
     options.pseudo_labels.symmetry_tolerance =
         ParseThreshold(cmd.symmetry_tolerance, object.diameter(), "--symmetry-tolerance");
@@ -148,12 +156,14 @@ int Run(SelftrainCommand cmd) {
     for (const auto& truth : data.truth) reference->scene_from_model.push_back(*truth);
     reference->symmetries = symmetries;
   }
+  // One frame per cloud when camera inputs are among them (free space), else none.
+  const std::vector<DepthView>* frames = data.frames.size() == clouds.size() ? &data.frames : nullptr;
   std::string eps_oc_evidence;
   if (cmd.thresholds.auto_eps_oc()) {
     // --eps-oc auto (CertifyBatch decides it): from the unlabelled clouds and
     // the oc distances of the sim-trained detector + corrector on them.
     const CertifiedFraction initial =
-        MeasureCertified(object, clouds, *detector, options.pipeline, /*auto_eps_oc=*/true);
+        MeasureCertified(object, clouds, *detector, options.pipeline, /*auto_eps_oc=*/true, frames);
     const AutoEpsOcResult& chosen = *initial.auto_eps_oc;
     options.pipeline.certificate.eps_oc = chosen.eps_oc;
     eps_oc_evidence = chosen.ToJson();
@@ -189,7 +199,7 @@ int Run(SelftrainCommand cmd) {
         progress = ProgressBar("selftrain", 1);
       },
       [&](std::size_t done, std::size_t total) { progress.Update(total ? done / total : 0); }, cmd.resume,
-      reference ? &*reference : nullptr, &data.groups);
+      reference ? &*reference : nullptr, &data.groups, frames);
   progress.Finish();
   nlohmann::json extra = {
       {"selftrained", true},

@@ -119,8 +119,9 @@ int Run(TrainCommand cmd) {
     for (std::size_t i = 0; i < train.size(); ++i) groups.push_back(static_cast<int>(i));
   }
   // Real frames: labelled by their ground truth, augmented like selftrain's.
-  const UnlabelledClouds camera =
+  UnlabelledClouds camera =
       LoadCameraClouds(&cmd.camera, object, cmd.options.seed, "c3po train", /*need_truth=*/true);
+  camera.frames.clear();   // supervised training certifies nothing: the depth images are not kept
   if (cmd.camera.given() && camera.clouds.empty()) {
     throw InputError(cmd.camera.bop.dir.empty() ? cmd.camera.frame.mask_path : cmd.camera.bop.dir,
                      "no instance could be read");

@@ -76,11 +76,12 @@ if [ $pointnet -eq 1 ]; then
   [ ! -e self.model ] || fail "selftrain wrote a model after a bad --robust-loss"
 fi
 
-# One input, one set of defaults (options.hpp InputKind): certify's depth
-# frames (BOP here) of an object without indicator sets get m = 2% and the TLS
-# kernel, m = 0 when the free-space test is off or the object has sets;
-# segments certified without their frame (eval --bop, selftrain --bop) get TLS
-# and m = 0; ready-made clouds keep the paper (m = 0, no kernel); a flag wins.
+# One input, one set of defaults (options.hpp InputKind): depth frames
+# certified with their frame (certify and selftrain with --bop) of an object
+# without indicator sets get m = 2% and the TLS kernel, m = 0 when the
+# free-space test is off or the object has sets; segments certified without
+# their frame (eval --bop, selftrain with --data as well) get TLS and m = 0;
+# ready-made clouds keep the paper (m = 0, no kernel); a flag wins.
 python3 - "$SRC/tests/fixtures/objects" <<'EOF' || fail "could not write cube_nosets.json"
 import json, os, sys
 spec = json.load(open(os.path.join(sys.argv[1], "cube.json")))
@@ -109,7 +110,10 @@ grep -q "outlier budget m = 0,.*robust kernel tls" e.out || fail "eval --bop def
 grep -q "outlier budget m = 0,.*robust kernel none" e.out || fail "eval --data defaults: $(grep 'outlier budget' e.out)"
 if [ $pointnet -eq 1 ]; then
   "$C3PO" selftrain "$NOSETS" --model cube.model --bop bop --obj-id 3 --copies 2 --epochs 1 -o self_bop.model     > s.out 2>&1 || fail "selftrain --bop exited $?: $(tail -1 s.out)"
-  [ "$(summary s.out)" == "m = 0, robust loss = tls" ] || fail "selftrain --bop defaults: '$(summary s.out)'"
+  [ "$(summary s.out)" == "m = 2%, robust loss = tls" ] || fail "selftrain --bop defaults: '$(summary s.out)'"
+  "$C3PO" selftrain "$NOSETS" --model cube.model --bop bop --obj-id 3 --data data --copies 2 --epochs 1 \
+    -o self_mixed.model > s.out 2>&1 || fail "selftrain --bop --data exited $?: $(tail -1 s.out)"
+  [ "$(summary s.out)" == "m = 0, robust loss = tls" ] || fail "selftrain --bop --data defaults: '$(summary s.out)'"
 fi
 
 echo "failures: $failures"

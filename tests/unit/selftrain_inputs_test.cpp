@@ -58,8 +58,12 @@ bool IsOrderedSubsequence(const PointSet& part, const PointSet& whole) {
 
 }  // namespace
 
-TEST_CASE("augmentation: copies drop the stated fraction, keep order, carry group, truth and name") {
-  const UnlabelledClouds data = Instances({1000, 37, 1, 2});
+TEST_CASE("augmentation: copies drop the stated fraction, keep order, carry group, truth, name and frame") {
+  UnlabelledClouds data = Instances({1000, 37, 1, 2});
+  // Each instance's depth frame (distinct images): every copy keeps its own.
+  for (std::size_t i = 0; i < data.clouds.size(); ++i) {
+    data.frames.push_back(DepthView{std::make_shared<DepthImage>(), PinholeCamera{}});
+  }
   AugmentOptions options;
   options.copies = 3;
   options.noise_sigma = 0.0;
@@ -77,6 +81,7 @@ TEST_CASE("augmentation: copies drop the stated fraction, keep order, carry grou
     CHECK(copies.truth[k]->t == data.truth[i]->t);
     CHECK(copies.names[k] == data.names[i] + "#" + std::to_string(k % 3));
     CHECK(copies.labels[k] == data.labels[i]);
+    CHECK(copies.frames[k].depth == data.frames[i].depth);
   }
   // The copies of one instance drop different points.
   CHECK(copies.clouds[0] != copies.clouds[1]);
@@ -88,6 +93,11 @@ TEST_CASE("augmentation: copies drop the stated fraction, keep order, carry grou
   // Nothing in, nothing out.
   options.copies = 4;
   CHECK(Augment(UnlabelledClouds{}, options).clouds.empty());
+  // Frames are optional (none at all), but one per cloud when given.
+  data.frames.clear();
+  CHECK(Augment(data, options).frames.empty());
+  data.frames.resize(1);
+  CHECK_THROWS_AS(Augment(data, options), std::invalid_argument);
 }
 
 TEST_CASE("augmentation: the noise has the stated sigma, the same seed gives the same clouds") {
@@ -140,9 +150,11 @@ TEST_CASE("loading sources: one group per image, unreadable sources skipped with
     CloudSource source;
     source.name = "s" + std::to_string(i);
     const PointSet cloud = i == 3 ? PointSet(3, 2) : clouds[i];
-    source.load_segment = [cloud]() {
+    source.load_segment = [cloud, i]() {
       SegmentCloud s;
       s.cloud = cloud;
+      s.depth = std::make_shared<DepthImage>();   // the image the segment came from
+      s.camera.fx = 500.0 + i;
       s.pixels.assign(static_cast<std::size_t>(cloud.cols()), 0);
       s.mask_pixels = s.pixels.size();
       return s;
@@ -173,6 +185,12 @@ TEST_CASE("loading sources: one group per image, unreadable sources skipped with
   CHECK(data.groups[3] == data.groups[4]);
   CHECK(std::set<int>{data.groups[0], data.groups[2], data.groups[3], data.groups[5]}.size() == 4);
   CHECK_FALSE(data.AllHaveTruth());   // s5 and the plain source have none
+  // Each segment keeps its frame (the free-space test of its certificates);
+  // the plain source has none.
+  REQUIRE(data.frames.size() == 6);
+  CHECK(data.frames[3].depth != nullptr);
+  CHECK(data.frames[3].camera.fx == 504.0);
+  CHECK(data.frames[5].depth == nullptr);
 }
 
 namespace {

@@ -109,6 +109,60 @@ TEST_CASE("self-training raises the certified fraction of a biased detector") {
   CHECK(after > 90.0);           // after self-training it is right without correction
 }
 
+TEST_CASE("camera frames: free space reaches the certificates of self-training, unknown depth changes nothing") {
+  const ObjectModel object = test::AsymmetricObject(6000);
+  // Clouds 1.5 m in front of the default camera, near its axis (in view).
+  std::vector<PointSet> clouds;
+  Rng rng(12);
+  for (int i = 0; i < 12; ++i) {
+    const Eigen::Vector3d t(rng.Uniform(-0.1, 0.1), rng.Uniform(-0.1, 0.1), 1.5);
+    clouds.push_back(SampleSurface(object.mesh(), 300, 70 + i).colwise() + t);
+  }
+  const auto frames_filled = [&](float depth) {
+    const CameraIntrinsics camera;
+    auto image = std::make_shared<DepthImage>();
+    image->width = camera.width;
+    image->height = camera.height;
+    image->z.assign(static_cast<std::size_t>(camera.width) * camera.height, depth);
+    return std::vector<DepthView>(clouds.size(), DepthView{image, camera});
+  };
+  // Oracle: a frame that measured 5 m everywhere saw through every place the
+  // object could be in front of it; a frame without depth knows nothing.
+  const std::vector<DepthView> seen_through = frames_filled(5.0f);
+  const std::vector<DepthView> blind = frames_filled(0.0f);
+  const PointSet offsets = CentredKeypoints(object).colwise() + Eigen::Vector3d(0.03, -0.02, 0.0);
+  SelfTrainOptions options = Options(object);
+  options.epochs = 2;
+  options.pipeline.certificate.global.enabled = false;   // not what is tested here (and the slowest part)
+
+  OffsetDetector probe(offsets, 0.5);
+  const CertifiedFraction plain = MeasureCertified(object, clouds, probe, options.pipeline);
+  const CertifiedFraction refuted = MeasureCertified(object, clouds, probe, options.pipeline, false, &seen_through);
+  int observably_correct = 0;
+  for (std::size_t i = 0; i < clouds.size(); ++i) {
+    CHECK_FALSE(plain.estimates[i].certificate.free_space.checked);
+    CHECK(refuted.estimates[i].certificate.free_space.checked);
+    CHECK_FALSE(refuted.estimates[i].certificate.free_space.passed);
+    CHECK_FALSE(FitsObservation(refuted.estimates[i]));
+    observably_correct += FitsObservation(plain.estimates[i]);
+  }
+  REQUIRE(observably_correct > 0);   // without the frames these would be pseudo-labels
+
+  OffsetDetector through(offsets, 0.5);
+  CHECK_THROWS_WITH_AS(SelfTrain(object, clouds, through, options, {}, {}, false, nullptr, nullptr, &seen_through),
+                       doctest::Contains("nothing to learn from"), InputError);
+
+  OffsetDetector without(offsets, 0.5), unknown(offsets, 0.5);
+  const SelfTrainResult a = SelfTrain(object, clouds, without, options);
+  const SelfTrainResult b = SelfTrain(object, clouds, unknown, options, {}, {}, false, nullptr, nullptr, &blind);
+  CHECK(a.epochs.front().certified_samples > 0);
+  CHECK(without.GetWeights() == unknown.GetWeights());
+  CHECK(a.pseudo_label_uses == b.pseudo_label_uses);
+  std::vector<DepthView> wrong_size(clouds.size() - 1);
+  CHECK_THROWS_AS(SelfTrain(object, clouds, unknown, options, {}, {}, false, nullptr, nullptr, &wrong_size),
+                  std::invalid_argument);
+}
+
 TEST_CASE("self-training with nothing certified stops with a clear message") {
   const ObjectModel object = test::AsymmetricObject(4000);
   // Clouds spread uniformly through a 2 m cube, over five times the object's size:
@@ -285,6 +339,53 @@ TEST_CASE("pseudo-label check: a flat near-symmetric object's flip is ambiguous,
   const Pose flip = HalfTurn(frame, 2);
   CHECK((flip * flip).R.isApprox(Eigen::Matrix3d::Identity(), 1e-12));
   CHECK((flip * frame.centroid - frame.centroid).norm() < 1e-12);
+}
+
+TEST_CASE("pseudo-label check: a second basin the frame refutes is no second explanation") {
+  // Oracle: stand-ins for the frame's free-space test. One refutes every pose
+  // whose keypoints lie farther than eps_oc from the estimate's (the camera
+  // saw through every other placement): the flat object's flip, ambiguous
+  // otherwise (test above), is then no second explanation. One refutes
+  // nothing: the check is unchanged.
+  struct OnlyNear : RivalFilter {
+    const ObjectModel* object = nullptr;
+    PointSet keypoints;
+    double radius = 0.0;
+    bool Passes(const Pose& pose, int* violations) const override {
+      const bool near = ((pose * object->keypoints()) - keypoints).colwise().norm().maxCoeff() <= radius;
+      *violations = near ? 0 : 1000;
+      return near;
+    }
+  };
+  struct Everything : RivalFilter {
+    bool Passes(const Pose&, int* violations) const override {
+      *violations = 0;
+      return true;
+    }
+  };
+  const ObjectModel flat = FlatNearSymmetricObject(0.004);
+  std::vector<Pose> truth;
+  const auto clouds = NoisyClouds(flat, 3, 0.0005, 21, &truth);
+  PipelineOptions pipeline;
+  pipeline.certificate = CertificateOptions::FromObject(flat.spec());
+  pipeline.certificate.eps_oc = 0.01;
+  const PrincipalFrame frame = ModelPrincipalFrame(flat);
+  for (std::size_t i = 0; i < clouds.size(); ++i) {
+    const PoseEstimate estimate = EstimateAndCertify(flat, clouds[i], truth[i] * flat.keypoints(), pipeline);
+    REQUIRE(estimate.certificate.oc.passed);
+    const Everything everything;
+    const PseudoLabelCheck unrefuted = CheckPseudoLabel(flat, clouds[i], estimate, pipeline, {}, frame, &everything);
+    CHECK(unrefuted.ambiguous);
+    CHECK(unrefuted.rivals_refuted == 0);
+    OnlyNear only_near;
+    only_near.object = &flat;
+    only_near.keypoints = estimate.scene_from_model * flat.keypoints();
+    only_near.radius = pipeline.certificate.eps_oc;
+    const PseudoLabelCheck check = CheckPseudoLabel(flat, clouds[i], estimate, pipeline, {}, frame, &only_near);
+    CHECK_FALSE(check.ambiguous);
+    CHECK(check.rivals_refuted >= 1);
+    CHECK(check.rival_residual < 0);   // no second basin left to compare
+  }
 }
 
 TEST_CASE("self-training on a flat near-symmetric object: the flip is learnt without the ambiguity rule, refused with it") {

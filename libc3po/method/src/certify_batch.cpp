@@ -96,9 +96,13 @@ std::vector<CloudSource> DatasetSources(const Dataset& dataset) {
 }
 
 std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
-                                         const std::vector<PointSet>& keypoints) {
+                                         const std::vector<PointSet>& keypoints,
+                                         const std::vector<DepthView>* frames) {
   if (!keypoints.empty() && keypoints.size() != clouds.size()) {
     throw std::invalid_argument("InMemorySources: keypoints.size() != clouds.size()");
+  }
+  if (frames != nullptr && frames->size() != clouds.size()) {
+    throw std::invalid_argument("InMemorySources: frames->size() != clouds.size()");
   }
   std::vector<CloudSource> sources;
   sources.reserve(clouds.size());
@@ -109,13 +113,17 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
     const PointSet* cloud = &clouds[i];
     source.load = [cloud]() { return *cloud; };
     if (!keypoints.empty()) source.given_keypoints = keypoints[i];
+    if (frames != nullptr) source.frame = (*frames)[i];
     sources.push_back(std::move(source));
   }
   return sources;
 }
 
 PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts, DepthView* frame) {
-  if (!source.load_segment) return source.load();
+  if (!source.load_segment) {
+    if (frame != nullptr && source.frame.valid()) *frame = source.frame;
+    return source.load();
+  }
   SegmentCloud segment = source.load_segment();
   PointSet cloud = std::move(segment.cloud);
   segment.cloud.resize(3, 0);   // the counts stay for the output

@@ -40,7 +40,7 @@ double FitResidual(const ObjectModel& object, const PointSet& cloud, const Pose&
 
 PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
                                   const PipelineOptions& pipeline, const PseudoLabelOptions& options,
-                                  const PrincipalFrame& frame) {
+                                  const PrincipalFrame& frame, const RivalFilter* observation) {
   PseudoLabelCheck check;
   check.residual = FitResidual(object, cloud, estimate.scene_from_model);
   if (options.symmetry_aware && estimate.ok()) {
@@ -61,6 +61,11 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
   for (const RivalFit& rival : RefineRivals(object, cloud, estimate, exact, frame, half_turns)) {
     if (!rival.ok) continue;
     if (rival.keypoint_distance <= eps_oc) continue;   // the same basin
+    int violations = -1;
+    if (observation != nullptr && !observation->Passes(rival.scene_from_model, &violations)) {
+      ++check.rivals_refuted;   // the frame rules this basin out
+      continue;
+    }
     if (options.symmetry_aware && rival.passes_oc &&
         PosedSurfaceHausdorff(object, queries, estimate.scene_from_model, rival.scene_from_model) <=
             symmetry_tolerance) {

@@ -12,6 +12,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "c3po/base/atomic_file.hpp"
@@ -24,6 +25,21 @@
 #include "c3po/method/selftrain_inputs.hpp"
 
 namespace c3po {
+
+namespace {
+
+// The free-space test of cloud i's frame (frames: nullptr or one per cloud),
+// when it has one and the test is on.
+std::optional<FreeSpaceTest> FrameTest(const ObjectModel& object, const std::vector<DepthView>* frames,
+                                       std::size_t i, const PipelineOptions& pipeline) {
+  std::optional<FreeSpaceTest> test;
+  if (frames != nullptr && (*frames)[i].valid() && pipeline.certificate.free_space.enabled) {
+    test.emplace(object, (*frames)[i], pipeline.certificate.free_space, pipeline.certificate.eps_oc);
+  }
+  return test;
+}
+
+}  // namespace
 
 void SelfTrainOptions::Check() const {
   if (epochs < 1) throw std::invalid_argument("epochs must be >= 1");
@@ -39,8 +55,14 @@ void SelfTrainOptions::Check() const {
   pipeline.Check();
 }
 
+bool FitsObservation(const PoseEstimate& estimate) {
+  const Certificate& c = estimate.certificate;
+  return estimate.ok() && c.oc.passed && (!c.free_space.checked || c.free_space.passed);
+}
+
 CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<PointSet>& clouds,
-                                   const Detector& detector, const PipelineOptions& options, bool auto_eps_oc) {
+                                   const Detector& detector, const PipelineOptions& options, bool auto_eps_oc,
+                                   const std::vector<DepthView>* frames) {
   CertifiedFraction result;
   if (clouds.empty()) return result;
   // The detector sees the clouds as one batch (DetectBatch); CertifyBatch
@@ -49,7 +71,7 @@ CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<
   batch.pipeline = options;
   batch.auto_eps_oc = auto_eps_oc;
   CertifyBatchResult certified =
-      CertifyBatch(object, InMemorySources(clouds, detector.DetectBatch(clouds)), nullptr, batch);
+      CertifyBatch(object, InMemorySources(clouds, detector.DetectBatch(clouds), frames), nullptr, batch);
   result.auto_eps_oc = std::move(certified.auto_eps_oc);
   result.estimates.reserve(clouds.size());
   for (CloudOutcome& outcome : certified.outcomes) {
@@ -96,10 +118,10 @@ double RotationAngleDegrees(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) 
 ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<PointSet>& clouds,
                                    const Detector& detector, const PipelineOptions& pipeline,
                                    const PseudoLabelOptions& pseudo_labels, const std::vector<Pose>* truth,
-                                   const std::vector<Pose>& symmetries) {
+                                   const std::vector<Pose>& symmetries, const std::vector<DepthView>* frames) {
   ValidationFit fit;
   if (clouds.empty()) return fit;
-  const CertifiedFraction measured = MeasureCertified(object, clouds, detector, pipeline);
+  const CertifiedFraction measured = MeasureCertified(object, clouds, detector, pipeline, false, frames);
   fit.percent_oc = measured.percent_oc;
   fit.percent_certified = measured.percent_certified;
   fit.detection_error = measured.detection_error;
@@ -110,10 +132,12 @@ ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<
     const PoseEstimate& e = measured.estimates[i];
     if (!e.ok()) return;
     PseudoLabelOptions options = pseudo_labels;
-    options.check_ambiguity = pseudo_labels.check_ambiguity && e.certificate.oc.passed;
-    const PseudoLabelCheck check = CheckPseudoLabel(object, clouds[i], e, pipeline, options, frame);
+    options.check_ambiguity = pseudo_labels.check_ambiguity && FitsObservation(e);
+    const std::optional<FreeSpaceTest> free_space = FrameTest(object, frames, i, pipeline);
+    const PseudoLabelCheck check =
+        CheckPseudoLabel(object, clouds[i], e, pipeline, options, frame, free_space ? &*free_space : nullptr);
     ambiguous[i] = check.ambiguous;
-    identified[i] = e.certificate.oc.passed && !check.ambiguous;
+    identified[i] = FitsObservation(e) && !check.ambiguous;
   });
   for (std::size_t i = 0; i < clouds.size(); ++i) {
     if (measured.estimates[i].ok()) {
@@ -230,7 +254,7 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
                     const std::vector<int>& order, TrainableDetector& detector,
                     const SelfTrainOptions& options, const ProgressCallback& progress,
                     std::size_t progress_offset, std::size_t progress_total, int epoch,
-                    std::vector<int>* pseudo_label_uses) {
+                    std::vector<int>* pseudo_label_uses, const std::vector<DepthView>* frames) {
   EpochStats stats;
   const PrincipalFrame frame = ModelPrincipalFrame(object);
   for (std::size_t start = 0; start < order.size(); start += options.batch) {
@@ -238,22 +262,30 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
     ThrowIfInterrupted();
     const std::size_t end = std::min(order.size(), start + options.batch);
     std::vector<PointSet> batch;
-    for (std::size_t k = start; k < end; ++k) batch.push_back(clouds[order[k]]);
-    const std::vector<PoseEstimate> estimates = MeasureCertified(object, batch, detector, options.pipeline).estimates;
+    std::vector<DepthView> batch_frames;
+    for (std::size_t k = start; k < end; ++k) {
+      batch.push_back(clouds[order[k]]);
+      if (frames != nullptr) batch_frames.push_back((*frames)[order[k]]);
+    }
+    const std::vector<DepthView>* views = frames != nullptr ? &batch_frames : nullptr;
+    const std::vector<PoseEstimate> estimates =
+        MeasureCertified(object, batch, detector, options.pipeline, false, views).estimates;
     // Ambiguous pseudo-labels (pseudo_label.hpp) are refused; a sample with
     // symmetric labellings is trained on the one nearest its detection (one
     // step of the symmetry-aware loss min_j ||ỹ - y_j||²).
     std::vector<PseudoLabelCheck> checks(batch.size());
     std::vector<char> usable(batch.size(), 0);
     ParallelFor(0, static_cast<int>(batch.size()), [&](int i) {
-      if (!estimates[i].ok() || !estimates[i].certificate.oc.passed) return;
-      checks[i] = CheckPseudoLabel(object, batch[i], estimates[i], options.pipeline, options.pseudo_labels, frame);
+      if (!FitsObservation(estimates[i])) return;
+      const std::optional<FreeSpaceTest> free_space = FrameTest(object, views, i, options.pipeline);
+      checks[i] = CheckPseudoLabel(object, batch[i], estimates[i], options.pipeline, options.pseudo_labels, frame,
+                                   free_space ? &*free_space : nullptr);
       usable[i] = !checks[i].ambiguous;
     });
     std::vector<PointSet> certified_clouds, targets;
     for (std::size_t i = 0; i < batch.size(); ++i) {
       stats.iterations += estimates[i].correction.iterations;
-      stats.certified += estimates[i].ok() && estimates[i].certificate.oc.passed;
+      stats.certified += FitsObservation(estimates[i]);
       stats.ambiguous += checks[i].ambiguous;
       if (usable[i]) {
         ++(*pseudo_label_uses)[static_cast<std::size_t>(order[start + i])];
@@ -305,7 +337,8 @@ bool Better(const ValidationFit& candidate, const ValidationFit& best, double re
 SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
                           TrainableDetector& detector, const SelfTrainOptions& options,
                           const EpochCallback& on_epoch, const ProgressCallback& progress,
-                          bool resume, const SelfTrainReference* reference, const std::vector<int>* groups) {
+                          bool resume, const SelfTrainReference* reference, const std::vector<int>* groups,
+                          const std::vector<DepthView>* frames) {
   options.Check();
   if (clouds.size() < 2) throw InputError("selftrain", "need at least 2 unlabelled clouds");
   if (reference != nullptr && reference->scene_from_model.size() != clouds.size()) {
@@ -314,6 +347,9 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   if (groups != nullptr && groups->size() != clouds.size()) {
     throw std::invalid_argument("SelfTrain: groups must match the clouds");
   }
+  if (frames != nullptr && frames->size() != clouds.size()) {
+    throw std::invalid_argument("SelfTrain: frames must match the clouds");
+  }
   // The split (by group when given): selftrain_inputs.hpp SplitValidation.
   const ValidationSplit split = SplitValidation(clouds.size(), groups, options.validation_fraction, options.seed, "selftrain");
   std::vector<int> all = split.validation;
@@ -321,15 +357,18 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   const std::size_t validation_count = split.validation.size();
   std::vector<PointSet> validation;
   std::vector<Pose> validation_truth;
+  std::vector<DepthView> validation_frames;
   for (std::size_t k = 0; k < validation_count; ++k) {
     validation.push_back(clouds[all[k]]);
+    if (frames != nullptr) validation_frames.push_back((*frames)[all[k]]);
     if (reference != nullptr) validation_truth.push_back(reference->scene_from_model[all[k]]);
   }
   const std::vector<Pose>* truth = reference != nullptr ? &validation_truth : nullptr;
   const std::vector<int> train(all.begin() + static_cast<long>(validation_count), all.end());
   const auto measure = [&] {
     return MeasureValidationFit(object, validation, detector, options.pipeline, options.pseudo_labels, truth,
-                                reference != nullptr ? reference->symmetries : std::vector<Pose>{});
+                                reference != nullptr ? reference->symmetries : std::vector<Pose>{},
+                                frames != nullptr ? &validation_frames : nullptr);
   };
 
   SelfTrainResult result;
@@ -375,7 +414,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     const std::vector<int> order = Shuffled(train, Rng::ForItem(options.seed, epoch));
     const EpochStats stats = RunEpoch(object, clouds, order, detector, options, progress,
                                       train.size() * (epoch - 1), progress_total, epoch,
-                                      &result.pseudo_label_uses);
+                                      &result.pseudo_label_uses, frames);
     if (epoch == 1 && stats.certified == 0) {
       throw InputError("selftrain", "no training cloud was observably correct in the first epoch: nothing to "
                                     "learn from (check eps_oc, the object, or train the detector on sim data first)");

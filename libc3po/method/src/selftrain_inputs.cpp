@@ -29,10 +29,11 @@ bool UnlabelledClouds::AllHaveTruth() const {
 
 UnlabelledClouds LoadUnlabelledClouds(const std::vector<CloudSource>& sources) {
   std::vector<PointSet> clouds(sources.size());
+  std::vector<DepthView> frames(sources.size());
   std::vector<std::string> errors(sources.size());
   ParallelFor(0, static_cast<int>(sources.size()), [&](int i) {
     try {
-      clouds[i] = LoadSourceCloud(sources[i]);
+      clouds[i] = LoadSourceCloud(sources[i], nullptr, &frames[i]);
     } catch (const std::exception& e) {
       errors[i] = e.what();
       if (errors[i].empty()) errors[i] = sources[i].name + ": unreadable";
@@ -57,6 +58,7 @@ UnlabelledClouds LoadUnlabelledClouds(const std::vector<CloudSource>& sources) {
       continue;
     }
     result.clouds.push_back(std::move(clouds[i]));
+    result.frames.push_back(std::move(frames[i]));
     result.groups.push_back(group);
     result.truth.push_back(sources[i].scene_from_model_truth);
     result.names.push_back(sources[i].name);
@@ -71,8 +73,8 @@ UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions
   options.Check();
   const std::size_t count = instances.clouds.size();
   if (instances.groups.size() != count || instances.truth.size() != count || instances.names.size() != count ||
-      instances.labels.size() != count) {
-    throw std::invalid_argument("Augment: groups, truth, names and labels must have one entry per cloud");
+      instances.labels.size() != count || (!instances.frames.empty() && instances.frames.size() != count)) {
+    throw std::invalid_argument("Augment: groups, truth, names, labels (and frames) must have one entry per cloud");
   }
   if (options.copies == 0) return instances;
   const std::size_t copies = static_cast<std::size_t>(options.copies);
@@ -110,6 +112,7 @@ UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions
     result.truth.push_back(instances.truth[i]);
     result.names.push_back(instances.names[i] + "#" + std::to_string(k % copies));
     result.labels.push_back(instances.labels[i]);
+    if (!instances.frames.empty()) result.frames.push_back(instances.frames[i]);
   }
   return result;
 }

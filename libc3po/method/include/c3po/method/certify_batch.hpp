@@ -45,6 +45,9 @@ struct CloudSource {
   // (segment.hpp); used instead of `load`, and the outcome keeps its counts.
   std::function<SegmentCloud()> load_segment;
   std::optional<CloudProvenance> provenance;   // BOP instances
+  // A cloud in memory that came from a depth frame (self-training's camera
+  // inputs and their augmented copies): the frame, for the free-space test.
+  DepthView frame;
 };
 
 // Cloud files given by path (named by their path).
@@ -53,16 +56,18 @@ std::vector<CloudSource> CloudFileSources(const std::vector<std::string>& paths)
 // detected_keypoints and ground-truth pose when the manifest has them.
 std::vector<CloudSource> DatasetSources(const Dataset& dataset);
 // Clouds already in memory (named "#i"), optionally with given keypoints
-// (keypoints.size() == clouds.size() or empty). The clouds are referenced, not
-// copied: they must outlive the batch.
+// (keypoints.size() == clouds.size() or empty) and the depth frame each came
+// from (frames: nullptr, or one per cloud; an invalid view = none). The
+// clouds are referenced, not copied: they must outlive the batch.
 std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
-                                         const std::vector<PointSet>& keypoints = {});
+                                         const std::vector<PointSet>& keypoints = {},
+                                         const std::vector<DepthView>* frames = nullptr);
 
 // Reads one source's cloud as CertifyBatch does: `load`, or `load_segment`
 // (image inputs) whose preprocessing counts go to `segment_counts` (when not
 // null; without the depth image) before a segment too small to use is
 // refused; `frame` (when not null) receives the segment's depth image and
-// camera for the free-space test (free_space.hpp). Throws InputError naming
+// camera for the free-space test (free_space.hpp), or the in-memory source's. Throws InputError naming
 // the source (unreadable file, empty or too small segment).
 PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts = nullptr,
                          DepthView* frame = nullptr);

@@ -55,6 +55,7 @@ struct PseudoLabelCheck {
   bool rival_passes_oc = false;
   double rival_keypoint_distance = 0.0;   // max_i ||y*_i - y'_i|| of that rival
   int rival_axis = -1;               // principal axis (0 = largest extent) of the flip
+  int rivals_refuted = 0;            // second basins the cloud's frame refutes (free space)
   // Keypoints of the second basins that pass oc within the symmetry
   // tolerance of the chosen pose (symmetry_aware only): y* and these are the
   // sample's labellings.
@@ -71,8 +72,12 @@ const PointSet& NearestLabelling(const PointSet& detected, const PointSet& chose
 double FitResidual(const ObjectModel& object, const PointSet& cloud, const Pose& scene_from_model);
 
 // `estimate` must be ok(); with check_ambiguity false only `residual` is filled.
+// `observation`: the cloud's free-space test (depth-frame inputs), else
+// nullptr; a second basin it refutes (the camera saw through where that pose
+// puts the model) is no second explanation and does not make the sample
+// ambiguous.
 PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
                                   const PipelineOptions& pipeline, const PseudoLabelOptions& options,
-                                  const PrincipalFrame& frame);
+                                  const PrincipalFrame& frame, const RivalFilter* observation = nullptr);
 
 }  // namespace c3po

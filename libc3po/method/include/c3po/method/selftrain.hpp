@@ -42,7 +42,7 @@ struct SelfTrainOptions {
 
 struct SelfTrainEpochLog {
   int epoch = 0;                      // 1-based
-  double train_percent_oc = 0.0;      // certified fraction of the training batches (before the steps)
+  double train_percent_oc = 0.0;      // % of the training clouds passing oc (and their frame's free space: FitsObservation), before the steps
   double validation_percent_oc = 0.0;
   double validation_percent_certified = 0.0;   // oc and nd
   double validation_detection_error = 0.0;     // RMS ||ỹ - y*|| on certified validation clouds
@@ -111,6 +111,10 @@ using EpochCallback = std::function<void(const SelfTrainEpochLog&)>;
 // Self-trains `detector` in place; on return it holds the best weights.
 // Throws InputError when no sample certifies in the first epoch (nothing to
 // learn from). With options.checkpoint_path, `resume` continues from it.
+// `frames` (nullptr, or one per cloud; an invalid view = none): the depth
+// frame each cloud came from. Where one is known, a pseudo-label must also
+// pass the free-space test, and a second basin the frame refutes is no
+// second explanation (pseudo_label.hpp), as in `certify`.
 // `groups` (same length as the clouds, e.g. the image of each real instance
 // and its augmented copies, selftrain_inputs.hpp): the validation split takes
 // whole groups (InputError with fewer than 2 groups); nullptr = every cloud
@@ -119,7 +123,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
                           TrainableDetector& detector, const SelfTrainOptions& options,
                           const EpochCallback& on_epoch = {}, const ProgressCallback& progress = {},
                           bool resume = false, const SelfTrainReference* reference = nullptr,
-                          const std::vector<int>* groups = nullptr);
+                          const std::vector<int>* groups = nullptr, const std::vector<DepthView>* frames = nullptr);
 
 // The validation criteria of `detector` on `clouds` (truth optional, for the
 // reporting fields).
@@ -127,7 +131,8 @@ ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<
                                    const Detector& detector, const PipelineOptions& pipeline,
                                    const PseudoLabelOptions& pseudo_labels,
                                    const std::vector<Pose>* truth = nullptr,
-                                   const std::vector<Pose>& symmetries = {});
+                                   const std::vector<Pose>& symmetries = {},
+                                   const std::vector<DepthView>* frames = nullptr);
 
 // % of clouds whose detector + corrector output is observably correct, and %
 // certified (oc and nd); optionally the mean corrector iterations.
@@ -146,8 +151,14 @@ struct CertifiedFraction {
 // CertifyBatch (certify_batch.hpp). `auto_eps_oc`: the `--eps-oc auto`
 // decision of CertifyBatch on these clouds (self-training takes eps_oc from
 // the clouds and the sim-trained detector before it starts).
+// `frames`: as SelfTrain's (the certificates run the free-space test where known).
 CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<PointSet>& clouds,
                                    const Detector& detector, const PipelineOptions& options,
-                                   bool auto_eps_oc = false);
+                                   bool auto_eps_oc = false, const std::vector<DepthView>* frames = nullptr);
+
+// Observably correct and, where the cloud's frame is known, consistent with
+// its free space: what a pseudo-label (and an identified validation cloud)
+// needs from the certificate.
+bool FitsObservation(const PoseEstimate& estimate);
 
 }  // namespace c3po

@@ -33,9 +33,13 @@ struct AugmentOptions {
 // labels[i]: the object the cloud shows when known ("obj_000005" for a BOP
 // instance of obj_id 5, the name annotate gives models/obj_000005.ply; a
 // manifest's "object"), "" otherwise; never used for training, only to
-// report what a mixed dataset's clouds of each object taught.
+// report what a mixed dataset's clouds of each object taught. frames[i]: the
+// depth frame clouds[i] came from (an invalid view for other sources; empty =
+// none at all): self-training certifies with the free-space test where a
+// frame is known, as `certify` does.
 struct UnlabelledClouds {
   std::vector<PointSet> clouds;
+  std::vector<DepthView> frames;
   std::vector<int> groups;
   std::vector<std::optional<Pose>> truth;
   std::vector<std::string> names;
@@ -50,7 +54,7 @@ UnlabelledClouds LoadUnlabelledClouds(const std::vector<CloudSource>& sources);
 
 // `copies` augmented copies of every cloud (in order: instance 0's copies,
 // then instance 1's, ...), each keeping its instance's group, truth and name
-// (+ "#c"). A copy keeps n - round(drop_fraction * n) points (at least 1, in
+// (+ "#c") and frame. A copy keeps n - round(drop_fraction * n) points (at least 1, in
 // their original order) and adds N(0, noise_sigma^2) to every coordinate.
 // std::invalid_argument when the per-cloud vectors differ in length.
 UnlabelledClouds Augment(const UnlabelledClouds& instances, const AugmentOptions& options);
