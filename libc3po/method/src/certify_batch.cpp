@@ -194,10 +194,8 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
       }
     }
     if (outcome.processed()) {
-      std::optional<FreeSpaceTest> free_space;
-      if (view.valid() && options.pipeline.certificate.free_space.enabled) {
-        free_space.emplace(object, view, options.pipeline.certificate.free_space, options.pipeline.certificate.eps_oc);
-      }
+      const std::optional<FreeSpaceTest> free_space = MakeFreeSpaceTest(
+          object, view, options.pipeline.certificate.free_space, options.pipeline.certificate.eps_oc);
       const FreeSpaceTest* free_space_test = free_space ? &*free_space : nullptr;
       if (options.also_uncorrected) {
         outcome.uncorrected =

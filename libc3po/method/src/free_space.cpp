@@ -71,6 +71,13 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   return result;
 }
 
+std::optional<FreeSpaceTest> MakeFreeSpaceTest(const ObjectModel& object, const DepthView& view,
+                                               const FreeSpaceOptions& options, double eps_oc) {
+  std::optional<FreeSpaceTest> test;
+  if (view.valid() && options.enabled) test.emplace(object, view, options, eps_oc);
+  return test;
+}
+
 bool FreeSpaceTest::Passes(const Pose& scene_from_model, int* violations) const {
   const FreeSpace result = Check(scene_from_model);
   if (violations) *violations = result.violations;

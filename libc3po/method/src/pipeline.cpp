@@ -21,9 +21,8 @@ namespace {
 // to decide (LocalNonDegeneracyOptions::weak_motion_check).
 bool WeakMotionCheckApplies(const Certificate& certificate, const CertificateOptions& options) {
   const NonDegeneracy& nd = certificate.nd;
-  return options.local.weak_motion_check && certificate.oc.passed && nd.sets_passed && nd.local_checked &&
-         !nd.local.passed && nd.local.weak_motions == 1 && nd.local.observed_points >= options.local.min_points &&
-         (!certificate.free_space.checked || certificate.free_space.passed);
+  return options.local.weak_motion_check && certificate.fits_observation() && nd.sets_passed && nd.local_checked &&
+         !nd.local.passed && nd.local.weak_motions == 1 && nd.local.observed_points >= options.local.min_points;
 }
 
 }  // namespace
@@ -52,7 +51,7 @@ void CompleteCertificate(const ObjectModel& object, const PointSet& cloud, const
 namespace {
 
 bool Refuted(const Certificate& certificate) {
-  return !certificate.oc.passed || (certificate.free_space.checked && !certificate.free_space.passed);
+  return !certificate.fits_observation();
 }
 
 // GlobalUniquenessOptions::reestimate: the refuted estimate is replaced by the

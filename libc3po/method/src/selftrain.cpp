@@ -28,15 +28,11 @@ namespace c3po {
 
 namespace {
 
-// The free-space test of cloud i's frame (frames: nullptr or one per cloud),
-// when it has one and the test is on.
+// The free-space test of cloud i's frame (frames: nullptr or one per cloud).
 std::optional<FreeSpaceTest> FrameTest(const ObjectModel& object, const std::vector<DepthView>* frames,
                                        std::size_t i, const PipelineOptions& pipeline) {
-  std::optional<FreeSpaceTest> test;
-  if (frames != nullptr && (*frames)[i].valid() && pipeline.certificate.free_space.enabled) {
-    test.emplace(object, (*frames)[i], pipeline.certificate.free_space, pipeline.certificate.eps_oc);
-  }
-  return test;
+  return MakeFreeSpaceTest(object, frames != nullptr ? (*frames)[i] : DepthView{}, pipeline.certificate.free_space,
+                           pipeline.certificate.eps_oc);
 }
 
 }  // namespace
@@ -56,8 +52,7 @@ void SelfTrainOptions::Check() const {
 }
 
 bool FitsObservation(const PoseEstimate& estimate) {
-  const Certificate& c = estimate.certificate;
-  return estimate.ok() && c.oc.passed && (!c.free_space.checked || c.free_space.passed);
+  return estimate.ok() && estimate.certificate.fits_observation();
 }
 
 CertifiedFraction MeasureCertified(const ObjectModel& object, const std::vector<PointSet>& clouds,

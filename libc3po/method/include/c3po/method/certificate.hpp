@@ -106,7 +106,10 @@ struct Certificate {
   ObservableCorrectness oc;
   NonDegeneracy nd;
   FreeSpace free_space;    // checked only for depth-image inputs (free_space.checked)
-  bool certified() const { return oc.passed && nd.passed && (!free_space.checked || free_space.passed); }
+  // The pose explains what was seen: oc and, for depth-image inputs, free
+  // space (nd aside). Failing it refutes an estimate; a pseudo-label needs it.
+  bool fits_observation() const { return oc.passed && (!free_space.checked || free_space.passed); }
+  bool certified() const { return fits_observation() && nd.passed; }
 };
 
 ObservableCorrectness CheckObservableCorrectness(const ObjectModel& object, const PointSet& cloud,

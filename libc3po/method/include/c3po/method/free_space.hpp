@@ -15,6 +15,7 @@
 // (Certificate::free_space) and on every rival of the global test (a rival
 // that violates free space is not a rival).
 #include <memory>
+#include <optional>
 
 #include "c3po/base/types.hpp"
 #include "c3po/geometry/camera.hpp"
@@ -67,5 +68,11 @@ class FreeSpaceTest : public RivalFilter {
   double tolerance_;
   std::unique_ptr<DepthRenderer> renderer_;
 };
+
+// The frame's test when the view holds a frame and the options enable it,
+// else empty: the one place the batch (certify_batch.hpp) and self-training
+// make it.
+std::optional<FreeSpaceTest> MakeFreeSpaceTest(const ObjectModel& object, const DepthView& view,
+                                               const FreeSpaceOptions& options, double eps_oc);
 
 }  // namespace c3po
