@@ -141,7 +141,7 @@ EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object,
     throw InputError(cmd.object_path, "the object has no eps_oc / delta_nd: give --eps-oc and --delta-nd");
   }
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
-  ResolveRobust(cmd.robust, cmd.bop.dir.empty() ? InputKind::kClouds : InputKind::kCameraSegments, object.spec(),
+  ResolveRobust(cmd.robust, cmd.bop.dir.empty() ? InputKind::kClouds : InputKind::kCameraFrames, object.spec(),
                 &options.pipeline.certificate, &options.pipeline.corrector);
   options.run_icp = !cmd.no_icp;
   options.run_ransac = !cmd.no_ransac;
@@ -242,15 +242,18 @@ int Run(const EvalCommand& cmd) {
                                  std::string(cmd.bop.dir.empty() ? "manifest lines)" : "images with usable instances)");
   ScratchFolder scratch;
   std::string data_dir = cmd.data_dir;
+  DatasetFrames frames;   // --bop: each instance's depth frame, for the free-space test
   if (!cmd.bop.dir.empty()) {
     CheckSegmentOptions(cmd.segment, "c3po eval");
-    const BopInstances listed = ListBopInstances(cmd.bop.dir, cmd.bop.options);
+    auto listed_shared = std::make_shared<const BopInstances>(ListBopInstances(cmd.bop.dir, cmd.bop.options));
+    const BopInstances& listed = *listed_shared;
     if (listed.instances.empty()) throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id));
     // --shard by image, before the instances become a dataset.
     const std::vector<BopInstance> instances = shard ? ShardBopInstances(listed.instances, *shard) : listed.instances;
     if (instances.empty()) throw InputError("--shard " + cmd.shard, empty_part);
     data_dir = scratch.path() + "/dataset";
     const BopDatasetSummary summary = WriteDatasetFromBop(instances, object.keypoints(), cmd.segment, data_dir);
+    frames = BopDatasetFrames(listed_shared, instances, cmd.segment);
     for (const std::string& reason : summary.skipped) std::cerr << "c3po eval: skipped " << reason << "\n";
     std::cerr << "c3po eval: " << summary.written << " BOP instances of obj_id " << cmd.bop.options.obj_id << " ("
               << summary.skipped.size() << " skipped)\n";
@@ -279,7 +282,8 @@ int Run(const EvalCommand& cmd) {
 
   ProgressBar progress("eval", dataset.entries.size());
   Evaluation evaluation =
-      Evaluate(object, dataset, detectors, options, [&](std::size_t done, std::size_t) { progress.Update(done); });
+      Evaluate(object, dataset, detectors, options, [&](std::size_t done, std::size_t) { progress.Update(done); },
+               frames);
   progress.Finish();
   // BOP input: name the BOP folder, not the temporary dataset it became.
   if (!cmd.bop.dir.empty()) evaluation.dataset_dir = cmd.bop.dir;

@@ -71,12 +71,12 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags);
 // given it decides the defaults (docs/method.md "Options and defaults"):
 enum class InputKind {
   kClouds,          // ready-made clouds: the paper, m = 0 and no kernel
-  // Segments cut from camera frames, certified without their frame (eval
-  // --bop; selftrain's camera inputs mixed with --data): kernel
-  // kDepthImageRobustLoss, m = 0.
+  // Segments cut from camera frames mixed with clouds that have no frame
+  // (selftrain's camera inputs with --data): kernel kDepthImageRobustLoss,
+  // m = 0.
   kCameraSegments,
   // Depth frames certified with their frame (certify --depth/--mask, --bop;
-  // selftrain's camera inputs alone): kernel
+  // eval --bop; selftrain's camera inputs alone): kernel
   // kDepthImageRobustLoss and, while the free-space test is on, the budget
   // kDepthImageOutlierFraction for objects without indicator sets. The budget
   // was measured sound on real frames only with free space (without it, 8

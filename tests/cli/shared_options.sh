@@ -77,11 +77,12 @@ if [ $pointnet -eq 1 ]; then
 fi
 
 # One input, one set of defaults (options.hpp InputKind): depth frames
-# certified with their frame (certify and selftrain with --bop) of an object
-# without indicator sets get m = 2% and the TLS kernel, m = 0 when the
+# certified with their frame (certify, eval and selftrain with --bop) of an
+# object without indicator sets get m = 2% and the TLS kernel, m = 0 when the
 # free-space test is off or the object has sets; segments certified without
-# their frame (eval --bop, selftrain with --data as well) get TLS and m = 0;
-# ready-made clouds keep the paper (m = 0, no kernel); a flag wins.
+# their frame (selftrain with --data as well) get TLS and m = 0; ready-made
+# clouds keep the paper (m = 0, no kernel); a flag wins. eval --bop certifies
+# what certify --bop certifies (the frame's free space included).
 python3 - "$SRC/tests/fixtures/objects" <<'EOF' || fail "could not write cube_nosets.json"
 import json, os, sys
 spec = json.load(open(os.path.join(sys.argv[1], "cube.json")))
@@ -105,7 +106,24 @@ summary() {   # the certify summary's budget and kernel
 "$C3PO" certify "$NOSETS" --data data --detector svd -o c.jsonl > c.out 2>&1 || true
 [ "$(summary c.out)" == "m = 0, robust loss = none" ] || fail "certify --data defaults: '$(summary c.out)'"
 "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --no-icp > e.out 2>&1 || fail "eval --bop exited $?: $(tail -1 e.out)"
-grep -q "outlier budget m = 0,.*robust kernel tls" e.out || fail "eval --bop defaults: $(grep 'outlier budget' e.out)"
+grep -q "outlier budget m = 2%,.*robust kernel tls" e.out || fail "eval --bop defaults: $(grep 'outlier budget' e.out)"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
+"$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --no-icp --json e.json > e.out 2>&1 || fail "eval --bop --json exited $?"
+python3 - <<'PY' || fail "eval --bop and certify --bop disagree"
+import json
+certify = [json.loads(line) for line in open('c.jsonl')]
+rows = json.load(open('e.json'))['rows']
+corrector = [r for r in rows if r['label'].endswith('+ corrector')][0]
+assert len(corrector['samples']) == len(certify) > 0, (len(corrector['samples']), len(certify))
+# Same segments, same defaults, same frame: the same decisions, instance by instance.
+by_name = {c['cloud'].replace('/', '_') + '.ply': c for c in certify}
+for s in corrector['samples']:
+    c = by_name[s['cloud']]
+    assert s['certified'] == c['certified'], (s['cloud'], s['certified'], c['certified'])
+    assert s['free_space'] == c['free_space'], (s['cloud'], s['free_space'], c['free_space'])
+PY
+"$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --no-icp --no-free-space > e.out 2>&1 || fail "eval --bop --no-free-space exited $?"
+grep -q "outlier budget m = 0,.*robust kernel tls" e.out || fail "eval --bop --no-free-space: $(grep 'outlier budget' e.out)"
 "$C3PO" eval "$NOSETS" --data data --detector svd --no-icp > e.out 2>&1 || fail "eval --data exited $?: $(tail -1 e.out)"
 grep -q "outlier budget m = 0,.*robust kernel none" e.out || fail "eval --data defaults: $(grep 'outlier budget' e.out)"
 if [ $pointnet -eq 1 ]; then

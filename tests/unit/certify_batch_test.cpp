@@ -139,8 +139,9 @@ TEST_CASE("CertifyBatch: also_uncorrected certifies T(y~) as well; the visitor s
   std::set<std::size_t> visited;
   const CertifyBatchResult result =
       CertifyBatch(f.object, InMemorySources(f.clouds, f.detected), nullptr, options, {},
-                   [&](std::size_t i, const PointSet& cloud, CloudOutcome* outcome) {
+                   [&](std::size_t i, const PointSet& cloud, const FreeSpaceTest* free_space, CloudOutcome* outcome) {
                      CHECK((cloud - f.clouds[i]).norm() == 0.0);
+                     CHECK(free_space == nullptr);   // no frames
                      CHECK(outcome->processed());
                      std::lock_guard<std::mutex> lock(mutex);
                      CHECK(visited.insert(i).second);

@@ -6,9 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <mutex>
 
 #include "c3po/base/error.hpp"
 #include "c3po/eval/evaluation.hpp"
+#include "c3po/geometry/render.hpp"
+#include "c3po/method/free_space.hpp"
 #include "evaluation_fixture.hpp"
 #include "test_helpers.hpp"
 
@@ -458,4 +462,72 @@ TEST_CASE("mixed dataset: rows from the object's clouds only, other objects' clo
   }
   CHECK_THROWS_WITH_AS(Evaluate(f.object, cubes, {{"manifest", nullptr, false}}, options),
                        doctest::Contains("no cloud of object"), InputError);
+}
+
+TEST_CASE("frames: every row's certificate includes the frame's free space, a frame without depth changes nothing") {
+  // The fixture's clouds moved 1.5 m in front of the default camera (in view).
+  const ObjectModel object = EvaluationObject();
+  TempDir dir("evaluation_frames_test");
+  std::vector<Pose> poses = EvaluationPoses(kClouds);
+  DatasetWriter writer(dir / "data");
+  for (int i = 0; i < kClouds; ++i) {
+    Pose& pose = poses[static_cast<std::size_t>(i)];
+    pose.t = Eigen::Vector3d(0.2 * (pose.t.x() - 0.5), 0.2 * (pose.t.y() - 0.5), 1.5);
+    DatasetEntry entry;
+    entry.cloud = std::to_string(i) + ".ply";
+    entry.pose = pose;
+    entry.detected_keypoints = DetectedKeypoints(object, pose, i);
+    writer.Add(static_cast<std::size_t>(i), entry, EvaluationCloud(object, pose, i));
+  }
+  writer.Commit();
+  const Dataset dataset = ReadDataset(dir / "data");
+  const auto filled = [](float depth) {
+    const CameraIntrinsics camera;
+    auto image = std::make_shared<DepthImage>();
+    image->width = camera.width;
+    image->height = camera.height;
+    image->z.assign(static_cast<std::size_t>(camera.width) * camera.height, depth);
+    return DepthView{image, camera};
+  };
+  // Oracle: a frame that measured 5 m everywhere saw through every place the
+  // object could be in front of it (every pose is refuted); a frame without
+  // depth (0 = unknown) or no frame at all refutes nothing.
+  const DepthView seen_through = filled(5.0f), blind = filled(0.0f);
+  std::vector<std::string> asked;
+  std::mutex mutex;
+  const DatasetFrames through = [&](const DatasetEntry& entry) {
+    std::lock_guard<std::mutex> lock(mutex);
+    asked.push_back(entry.cloud);
+    return seen_through;
+  };
+  EvaluationOptions options = EvaluationOptions::Defaults(object);
+  options.pipeline.certificate.global.enabled = false;   // not what is tested here
+  const std::vector<EvaluatedDetector> detectors = {{"manifest", nullptr, false}};
+  const Evaluation plain = Evaluate(object, dataset, detectors, options);
+  const Evaluation refuted = Evaluate(object, dataset, detectors, options, {}, through);
+  const Evaluation unknown =
+      Evaluate(object, dataset, detectors, options, {}, [&](const DatasetEntry&) { return blind; });
+  const Evaluation none = Evaluate(object, dataset, detectors, options, {}, [](const DatasetEntry&) { return DepthView{}; });
+  REQUIRE(refuted.rows.size() == plain.rows.size());
+  CHECK(asked.size() == static_cast<std::size_t>(kClouds));   // one read per cloud and detector
+  int certified_without = 0;
+  for (std::size_t r = 0; r < plain.rows.size(); ++r) {
+    CAPTURE(plain.rows[r].label);
+    certified_without += plain.rows[r].summary.certified;
+    CHECK(refuted.rows[r].summary.certified == 0);   // KeyPo, + ICP, + RANSAC + ICP, + corrector
+    for (std::size_t k = 0; k < plain.rows[r].samples.size(); ++k) {
+      const SampleResult& s = refuted.rows[r].samples[k];
+      CHECK(plain.rows[r].samples[k].free_space);
+      if (s.ok()) CHECK_FALSE(s.free_space);
+      CHECK(s.oc == plain.rows[r].samples[k].oc);   // the distances do not see the frame
+      CHECK(unknown.rows[r].samples[k].certified() == plain.rows[r].samples[k].certified());
+      CHECK(none.rows[r].samples[k].certified() == plain.rows[r].samples[k].certified());
+      CHECK(unknown.rows[r].samples[k].free_space);
+    }
+  }
+  REQUIRE(certified_without > 0);   // without the frames these would be certified
+  CHECK(refuted.total_false_certificates() == 0);
+  // The samples file carries the free-space decision.
+  const std::string text = EvaluationJson(refuted);
+  CHECK(text.find("\"free_space\": false") != std::string::npos);
 }

@@ -74,6 +74,7 @@ SampleResult FromEstimate(std::size_t index, const std::string& cloud, const Pos
   sample.detected_keypoints = estimate.detected_keypoints;
   sample.oc = estimate.certificate.oc.passed;
   sample.nd = estimate.certificate.nd.passed;
+  sample.free_space = !estimate.certificate.free_space.checked || estimate.certificate.free_space.passed;
   sample.oc_distance = estimate.certificate.oc.max_point_distance;
   sample.outlier_indices = estimate.certificate.oc.outlier_indices;
   sample.milliseconds = estimate.milliseconds;
@@ -83,7 +84,7 @@ SampleResult FromEstimate(std::size_t index, const std::string& cloud, const Pos
 // "KeyPo + ICP": ICP from the registration, certified with keypoints T·b.
 SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
                               const SampleResult& registration, const EvaluationOptions& options,
-                              bool ransac = false) {
+                              const FreeSpaceTest* free_space, bool ransac = false) {
   if (!registration.ok()) {
     SampleResult failed = Failure(registration.index, registration.cloud, registration.error);
     failed.detected_keypoints = registration.detected_keypoints;
@@ -116,10 +117,11 @@ SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
   refined.keypoints = sample.keypoints;
   refined.certificate = Certify(object, cloud, sample.scene_from_model, sample.keypoints,
                                 options.pipeline.certificate);
-  CompleteCertificate(object, cloud, options.pipeline, nullptr, &refined);
+  CompleteCertificate(object, cloud, options.pipeline, free_space, &refined);
   const Certificate& certificate = refined.certificate;
   sample.oc = certificate.oc.passed;
   sample.nd = certificate.nd.passed;
+  sample.free_space = !certificate.free_space.checked || certificate.free_space.passed;
   sample.oc_distance = certificate.oc.max_point_distance;
   sample.outlier_indices = certificate.oc.outlier_indices;
   sample.milliseconds = registration.milliseconds +
@@ -141,17 +143,18 @@ DetectorResults EvaluateDetector(const ObjectModel& object, const Dataset& datas
   batch.pipeline = options.pipeline;
   batch.pipeline.correct = true;
   batch.also_uncorrected = !detector.self_trained;
-  const auto visit = [&](std::size_t i, const PointSet& cloud, CloudOutcome* outcome) {
+  const auto visit = [&](std::size_t i, const PointSet& cloud, const FreeSpaceTest* free_space,
+                         CloudOutcome* outcome) {
     const std::string& name = dataset.entries[i].cloud;
     const Pose& truth = *dataset.entries[i].pose;
     if (outcome->uncorrected) {
       out[kRegistration][i] = FromEstimate(i, name, *outcome->uncorrected);
       ScoreAgainstTruth(object, truth, options, &out[kRegistration][i]);
       if (options.run_icp) {
-        out[kIcp][i] = RefineAndCertify(object, cloud, out[kRegistration][i], options);
+        out[kIcp][i] = RefineAndCertify(object, cloud, out[kRegistration][i], options, free_space);
         ScoreAgainstTruth(object, truth, options, &out[kIcp][i]);
         if (options.run_ransac) {
-          out[kRansacIcp][i] = RefineAndCertify(object, cloud, out[kRegistration][i], options, true);
+          out[kRansacIcp][i] = RefineAndCertify(object, cloud, out[kRegistration][i], options, free_space, true);
           ScoreAgainstTruth(object, truth, options, &out[kRansacIcp][i]);
         }
       }
@@ -312,7 +315,7 @@ EvaluationRow MakeEvaluationRow(EvalMethod method, EvalSubset subset, const std:
   row.method = method;
   row.subset = subset;
   for (const auto& s : all_samples) {
-    if (subset == EvalSubset::kAll || (subset == EvalSubset::kObservablyCorrect && s.oc) ||
+    if (subset == EvalSubset::kAll || (subset == EvalSubset::kObservablyCorrect && s.fits_observation()) ||
         (subset == EvalSubset::kCertified && s.certified())) {
       row.samples.push_back(s);
     }
@@ -367,7 +370,8 @@ RowSummary Summarize(const std::vector<SampleResult>& samples, const EvaluationO
 
 Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
                     const std::vector<EvaluatedDetector>& detectors,
-                    const EvaluationOptions& options, const ProgressCallback& progress) {
+                    const EvaluationOptions& options, const ProgressCallback& progress,
+                    const DatasetFrames& frames) {
   options.Check();
   if (detectors.empty()) throw std::invalid_argument("Evaluate: no detectors");
   // Mixed datasets: the object's own clouds make the rows, the others are
@@ -389,7 +393,7 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
   }
   CheckDataset(own_dataset, detectors);
   const std::size_t count = own_dataset.entries.size();
-  const std::vector<CloudSource> sources = DatasetSources(own_dataset);
+  const std::vector<CloudSource> sources = DatasetSources(own_dataset, frames);
   std::vector<DetectorResults> results;
   for (std::size_t d = 0; d < detectors.size(); ++d) {
     // Progress over all detectors' clouds, reported as clouds of the dataset.
@@ -405,7 +409,7 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
     for (std::size_t i = 0; i < other_dataset.entries.size(); ++i) {
       other_by_label[*other_dataset.entries[i].object].push_back(i);
     }
-    const std::vector<CloudSource> other_sources = DatasetSources(other_dataset);
+    const std::vector<CloudSource> other_sources = DatasetSources(other_dataset, frames);
     CertifyBatchOptions batch;
     batch.pipeline = options.pipeline;
     batch.pipeline.correct = true;
@@ -417,7 +421,7 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
       for (const SampleResult& sample : results[d][kCorrected]) {
         ++own.clouds;
         own.failures += !sample.ok();
-        own.observably_correct += sample.oc;
+        own.observably_correct += sample.fits_observation();
         own.certified += sample.certified();
       }
       objects.push_back(own);
@@ -433,7 +437,7 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
           const CloudOutcome& outcome = other.outcomes[i];
           ++a.clouds;
           a.failures += !outcome.processed();
-          a.observably_correct += outcome.processed() && outcome.estimate.ok() && outcome.estimate.certificate.oc.passed;
+          a.observably_correct += outcome.processed() && outcome.estimate.ok() && outcome.estimate.certificate.fits_observation();
           a.certified += outcome.certified();
         }
         objects.push_back(a);

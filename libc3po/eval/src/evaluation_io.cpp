@@ -131,6 +131,7 @@ json SampleJson(const SampleResult& s) {
   j["translation_error"] = Number(s.translation_error);
   j["oc"] = s.oc;
   j["nd"] = s.nd;
+  j["free_space"] = s.free_space;
   j["certified"] = s.certified();
   j["oc_distance"] = Number(s.oc_distance);
   if (s.certified()) j["hausdorff"] = Number(s.hausdorff);

@@ -187,6 +187,7 @@ json SampleLine(int row, const SampleResult& s) {
   j["translation_error"] = Exact(s.translation_error);
   j["oc"] = s.oc;
   j["nd"] = s.nd;
+  j["free_space"] = s.free_space;
   j["oc_distance"] = Exact(s.oc_distance);
   j["hausdorff"] = Exact(s.hausdorff);   // NaN unless certified (eval's Hausdorff check)
   j["ms"] = Exact(s.milliseconds);
@@ -222,6 +223,8 @@ SampleResult ReadSample(const json& line, const std::string& where) {
   s.translation_error = Number(line, "translation_error", where);
   s.oc = Bool(line, "oc", where);
   s.nd = Bool(line, "nd", where);
+  // Sample files written before frames were evaluated have no "free_space": no frame.
+  s.free_space = line.contains("free_space") ? Bool(line, "free_space", where) : true;
   s.oc_distance = Number(line, "oc_distance", where);
   s.hausdorff = Number(line, "hausdorff", where);
   s.milliseconds = Number(line, "ms", where);

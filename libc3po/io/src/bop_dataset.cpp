@@ -12,6 +12,12 @@
 
 namespace c3po {
 
+std::string BopDatasetCloudName(const BopInstance& instance) {
+  char name[64];
+  std::snprintf(name, sizeof name, "%06d_%06d_%06d.ply", instance.scene_id, instance.im_id, instance.gt_id);
+  return name;
+}
+
 BopDatasetSummary WriteDatasetFromBop(const std::vector<BopInstance>& instances, const PointSet& model_keypoints,
                                   const SegmentOptions& options, const std::string& dir) {
   for (const BopInstance& instance : instances) {
@@ -22,13 +28,12 @@ BopDatasetSummary WriteDatasetFromBop(const std::vector<BopInstance>& instances,
   ParallelFor(0, static_cast<int>(instances.size()), [&](int i) {
     ThrowIfInterrupted();
     const BopInstance& instance = instances[static_cast<std::size_t>(i)];
-    char name[64];
-    std::snprintf(name, sizeof name, "%06d_%06d_%06d", instance.scene_id, instance.im_id, instance.gt_id);
+    const std::string name = BopDatasetCloudName(instance);
     try {
       const SegmentCloud segment = LoadBopInstance(instance, options);
-      RequireUsableSegment(segment, name);
+      RequireUsableSegment(segment, name.substr(0, name.size() - 4));
       DatasetEntry entry;
-      entry.cloud = std::string(name) + ".ply";
+      entry.cloud = name;
       entry.pose = *instance.ground_truth;
       entry.keypoints = *instance.ground_truth * model_keypoints;
       writer.Add(static_cast<std::size_t>(i), entry, segment.cloud);

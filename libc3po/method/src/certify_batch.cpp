@@ -77,7 +77,7 @@ std::vector<CloudSource> CloudFileSources(const std::vector<std::string>& paths)
   return sources;
 }
 
-std::vector<CloudSource> DatasetSources(const Dataset& dataset) {
+std::vector<CloudSource> DatasetSources(const Dataset& dataset, const DatasetFrames& frames) {
   std::vector<CloudSource> sources;
   sources.reserve(dataset.entries.size());
   for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
@@ -90,6 +90,7 @@ std::vector<CloudSource> DatasetSources(const Dataset& dataset) {
     source.load = [path]() { return ReadCloud(path); };
     source.given_keypoints = entry.detected_keypoints;
     source.scene_from_model_truth = entry.pose;
+    if (frames) source.load_frame = [frames, entry]() { return frames(entry); };
     sources.push_back(std::move(source));
   }
   return sources;
@@ -113,7 +114,10 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
     const PointSet* cloud = &clouds[i];
     source.load = [cloud]() { return *cloud; };
     if (!keypoints.empty()) source.given_keypoints = keypoints[i];
-    if (frames != nullptr) source.frame = (*frames)[i];
+    if (frames != nullptr) {
+      const DepthView view = (*frames)[i];
+      source.load_frame = [view]() { return view; };
+    }
     sources.push_back(std::move(source));
   }
   return sources;
@@ -121,8 +125,9 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
 
 PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts, DepthView* frame) {
   if (!source.load_segment) {
-    if (frame != nullptr && source.frame.valid()) *frame = source.frame;
-    return source.load();
+    PointSet cloud = source.load();
+    if (frame != nullptr && source.load_frame) *frame = source.load_frame();
+    return cloud;
   }
   SegmentCloud segment = source.load_segment();
   PointSet cloud = std::move(segment.cloud);
@@ -209,7 +214,7 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
                                                       outcome.estimate.scene_from_model);
       }
       outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (visit) visit(static_cast<std::size_t>(i), cloud, &outcome);
+      if (visit) visit(static_cast<std::size_t>(i), cloud, free_space_test, &outcome);
       if (options.auto_eps_oc) clouds[i] = std::move(cloud);
     }
     if (outcome.seconds == 0.0) {

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <map>
+#include <string>
 #include <memory>
 #include <utility>
 
@@ -68,6 +69,18 @@ std::vector<BopInstance> ShardBopInstances(const std::vector<BopInstance>& insta
   std::vector<BopInstance> part;
   for (std::size_t i : ShardJobs(keys, shard)) part.push_back(instances[i]);
   return part;
+}
+
+DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances,
+                               const SegmentOptions& options) {
+  auto by_cloud = std::make_shared<std::map<std::string, BopInstance>>();
+  for (const BopInstance& instance : instances) (*by_cloud)[BopDatasetCloudName(instance)] = instance;
+  return [listed, by_cloud, options](const DatasetEntry& entry) {
+    const auto it = by_cloud->find(entry.cloud);
+    if (it == by_cloud->end()) return DepthView{};
+    const SegmentCloud segment = LoadBopInstance(it->second, options);
+    return DepthView{segment.depth, segment.camera};
+  };
 }
 
 std::vector<BopResultRow> BopResultRows(const std::vector<CloudSource>& sources, const CertifyBatchResult& result) {

@@ -32,6 +32,7 @@
 
 #include "c3po/eval/metrics.hpp"
 #include "c3po/io/dataset.hpp"
+#include "c3po/method/certify_batch.hpp"
 #include "c3po/method/detector.hpp"
 #include "c3po/method/icp.hpp"
 #include "c3po/method/keypoint_ransac.hpp"
@@ -87,6 +88,9 @@ struct SampleResult {
   double translation_error = 0.0;      // object units
   bool oc = false;
   bool nd = false;
+  // The depth frame's free-space test (docs/method.md) passed, or the cloud
+  // came without its frame (Evaluate's `frames`).
+  bool free_space = true;
   double oc_distance = 0.0;            // max_x min_p ||x - p|| (evidence of oc)
   // Certified samples only (NaN otherwise): the symmetric Hausdorff distance
   // between the model posed at the truth and at T̂ (PosedModelHausdorff, 2000
@@ -95,7 +99,8 @@ struct SampleResult {
   std::vector<int> outlier_indices;    // input points at >= eps_oc (oc_m's outliers, ascending)
   double milliseconds = 0.0;           // estimation + certification time of this method
   bool ok() const { return error.empty(); }
-  bool certified() const { return oc && nd; }
+  bool fits_observation() const { return oc && free_space; }   // Certificate::fits_observation
+  bool certified() const { return fits_observation() && nd; }
 };
 
 struct FalseCertificate {
@@ -188,9 +193,13 @@ EvaluationRow MakeEvaluationRow(EvalMethod method, EvalSubset subset, const std:
 // or, for a manifest detector, no detected_keypoints; std::invalid_argument
 // for bad options. Unreadable clouds and detector failures are per-sample
 // failures. `progress` is called (from worker threads) after each cloud.
+// `frames` (when given) names the depth frame each entry's cloud came from
+// (eval --bop): every row's certificate then includes the frame's free-space
+// test (options.pipeline.certificate.free_space), as `certify --bop` does.
 Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
                     const std::vector<EvaluatedDetector>& detectors,
-                    const EvaluationOptions& options, const ProgressCallback& progress = {});
+                    const EvaluationOptions& options, const ProgressCallback& progress = {},
+                    const DatasetFrames& frames = {});
 
 // The terminal table: aligned columns, one line per row, then the settings
 // (ADD-S variant, thresholds, certificate thresholds) and the soundness figure.

@@ -16,8 +16,11 @@ struct BopDatasetSummary {
   std::vector<std::string> skipped;   // "SSSSSS/IIIIII_GGGGGG: reason" (no usable segment)
 };
 
+// The manifest's cloud name of an instance: SSSSSS_IIIIII_GGGGGG.ply.
+std::string BopDatasetCloudName(const BopInstance& instance);
+
 // Writes `dir` (DatasetWriter: atomic, replaces an existing dataset). Clouds
-// are named SSSSSS_IIIIII_GGGGGG.ply. Instances without ground truth (from
+// are named by BopDatasetCloudName. Instances without ground truth (from
 // detections) are an InputError("dir", ...); instances whose segment is
 // unusable (RequireUsableSegment) are skipped and listed.
 BopDatasetSummary WriteDatasetFromBop(const std::vector<BopInstance>& instances, const PointSet& model_keypoints,

@@ -45,16 +45,23 @@ struct CloudSource {
   // (segment.hpp); used instead of `load`, and the outcome keeps its counts.
   std::function<SegmentCloud()> load_segment;
   std::optional<CloudProvenance> provenance;   // BOP instances
-  // A cloud in memory that came from a depth frame (self-training's camera
-  // inputs and their augmented copies): the frame, for the free-space test.
-  DepthView frame;
+  // A cloud read by `load` that came from a depth frame (self-training's
+  // camera inputs and their augmented copies in memory; eval --bop's dataset
+  // written from BOP instances): reads the frame, for the free-space test.
+  // Empty: no frame. Called in the worker thread; throws InputError naming
+  // the file when the frame cannot be read (a per-cloud failure).
+  std::function<DepthView()> load_frame;
 };
+
+// The depth frame a dataset entry's cloud came from (an invalid view: none).
+using DatasetFrames = std::function<DepthView(const DatasetEntry& entry)>;
 
 // Cloud files given by path (named by their path).
 std::vector<CloudSource> CloudFileSources(const std::vector<std::string>& paths);
 // Every entry of a dataset (named by the manifest's "cloud"), with its
-// detected_keypoints and ground-truth pose when the manifest has them.
-std::vector<CloudSource> DatasetSources(const Dataset& dataset);
+// detected_keypoints and ground-truth pose when the manifest has them, and
+// its depth frame when `frames` is given.
+std::vector<CloudSource> DatasetSources(const Dataset& dataset, const DatasetFrames& frames = {});
 // Clouds already in memory (named "#i"), optionally with given keypoints
 // (keypoints.size() == clouds.size() or empty) and the depth frame each came
 // from (frames: nullptr, or one per cloud; an invalid view = none). The
@@ -67,8 +74,9 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
 // (image inputs) whose preprocessing counts go to `segment_counts` (when not
 // null; without the depth image) before a segment too small to use is
 // refused; `frame` (when not null) receives the segment's depth image and
-// camera for the free-space test (free_space.hpp), or the in-memory source's. Throws InputError naming
-// the source (unreadable file, empty or too small segment).
+// camera for the free-space test (free_space.hpp), or the source's
+// load_frame(). Throws InputError naming the source (unreadable file, empty
+// or too small segment).
 PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts = nullptr,
                          DepthView* frame = nullptr);
 
@@ -112,9 +120,11 @@ struct CertifyBatchResult {
 };
 
 // Called in the worker thread right after cloud `index` is certified, while
-// the cloud is in memory (eval refines with ICP there). Not called for clouds
-// that failed to load.
-using CloudVisitor = std::function<void(std::size_t index, const PointSet& cloud, CloudOutcome* outcome)>;
+// the cloud is in memory (eval refines with ICP there), with the frame's
+// free-space test the estimate was certified with (nullptr: none). Not
+// called for clouds that failed to load.
+using CloudVisitor = std::function<void(std::size_t index, const PointSet& cloud, const FreeSpaceTest* free_space,
+                                        CloudOutcome* outcome)>;
 
 // Certifies every source (in parallel over clouds). `detector` nullptr: every
 // source must carry given keypoints (InputError naming the first that does

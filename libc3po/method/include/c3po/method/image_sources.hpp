@@ -3,9 +3,11 @@
 // issue 15, docs/camera_inputs.md): a depth frame + mask, BOP instances with
 // their ids and ground truth, --shard by image, and the BOP results rows of a
 // batch.
+#include <memory>
 #include <vector>
 
 #include "c3po/io/bop.hpp"
+#include "c3po/io/bop_dataset.hpp"
 #include "c3po/io/segment.hpp"
 #include "c3po/io/shard.hpp"
 #include "c3po/method/certify_batch.hpp"
@@ -25,6 +27,12 @@ std::vector<CloudSource> ShardSources(const std::vector<CloudSource>& sources, c
 // The same parts of a BOP instance list (eval --shard: instances become a
 // dataset); instances keep pointing into their BopInstances' detections.
 std::vector<BopInstance> ShardBopInstances(const std::vector<BopInstance>& instances, const Shard& shard);
+// The depth frames of a dataset written from BOP instances (WriteDatasetFromBop,
+// eval --bop): an entry's frame is its instance's depth image and camera
+// (read when asked); an entry no instance names has none. `listed` keeps the
+// instances' detections alive.
+DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances,
+                               const SegmentOptions& options);
 // BOP results rows (bop.hpp) from a batch: one per BOP source whose
 // registration succeeded; score = CertificateScore with the batch's eps_oc;
 // time = the seconds of all the object's sources of that image.
