@@ -64,8 +64,10 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_flag("--no-global-check", flags->no_global_check,
                    "nd without the global rival search (restarts of the corrector at turned poses; on by default)");
   command.add_flag("--reestimate", flags->reestimate,
-                   "When the estimate fails oc or free space, restart the corrector at the rival search's turns and "
-                   "certify the best fit that passes instead (off by default)");
+                   "When the estimate fails oc or free space, restart the corrector at turns about 13 axes and "
+                   "certify the best fit that passes instead, unless another restart fits too (off by default)");
+  command.add_option("--reestimate-steps", flags->reestimate_steps,
+                     "--reestimate starts: rotations by k*360/N deg about each of 13 axes (N even, default 12)");
   command.add_flag("--no-weak-motion-check", flags->no_weak_motion_check,
                    "A single motion the local test finds weak fails nd (by default the pose is displaced along it "
                    "and refitted: no second fit = constrained)");
@@ -106,6 +108,10 @@ void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& 
   certificate->local.weak_motion_check = !flags.no_weak_motion_check;
   certificate->global.reestimate = flags.reestimate;
   certificate->global.steps = flags.global_steps;
+  certificate->global.reestimate_steps = flags.reestimate_steps;
+  if (flags.reestimate_steps < 2 || flags.reestimate_steps > 36 || flags.reestimate_steps % 2 != 0) {
+    throw InputError("--reestimate-steps", std::to_string(flags.reestimate_steps) + " must be even and in [2, 36]");
+  }
   if (flags.global_steps < 2 || flags.global_steps > 36 || flags.global_steps % 2 != 0) {
     throw InputError("--global-steps", std::to_string(flags.global_steps) + " must be even and in [2, 36]");
   }
@@ -148,6 +154,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (flags.no_weak_motion_check) line += " --no-weak-motion-check";
   if (flags.reestimate) line += " --reestimate";
   if (flags.global_steps != 4) line += " --global-steps " + std::to_string(flags.global_steps);
+  if (flags.reestimate_steps != 12) line += " --reestimate-steps " + std::to_string(flags.reestimate_steps);
   if (flags.no_free_space) line += " --no-free-space";
   if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;
   return line;

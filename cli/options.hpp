@@ -63,6 +63,7 @@ struct RobustFlags {
   bool reestimate = false;         // --reestimate: restart a refuted estimate at the rival turns
   bool no_weak_motion_check = false;   // --no-weak-motion-check: a single weak motion fails nd
   int global_steps = 4;            // --global-steps
+  int reestimate_steps = 12;       // --reestimate-steps
   bool no_free_space = false;      // --no-free-space (depth-image inputs)
   std::string free_space_fraction; // --free-space-fraction ("" = default)
 };

@@ -63,6 +63,7 @@ for c in certify eval; do
   bad_value --max-outliers "$C3PO" $c "$OBJ" "${det[@]}" --data data --max-outliers 3x
   bad_value --robust-loss "$C3PO" $c "$OBJ" "${det[@]}" --data data --robust-loss huber
   bad_value --nd-min-eigenvalue "$C3PO" $c "$OBJ" "${det[@]}" --data data --nd-min-eigenvalue -1
+  bad_value --reestimate-steps "$C3PO" $c "$OBJ" "${det[@]}" --data data --reestimate --reestimate-steps 5
 done
 bad_value --max-outliers "$C3PO" bench corrector "$OBJ" --data data --max-outliers -2
 bad_value --eps-oc "$C3PO" eval "$OBJ" --detector manifest --data data --eps-oc auto

@@ -397,8 +397,10 @@ TEST_CASE("re-estimation: a flipped start is refuted, the restart at the half-tu
   options.certificate.global.reestimate = true;
   const PoseEstimate restarted = EstimateAndCertify(object, cloud, flipped_keypoints, options);
   REQUIRE(restarted.ok());
-  CHECK(restarted.restarts_tried == 9);
+  CHECK(restarted.restarts_tried == 13 * (options.certificate.global.reestimate_steps - 1));
   CHECK(restarted.restart_axis >= 0);
+  CHECK(restarted.certificate.nd.global_checked);
+  CHECK(restarted.certificate.nd.global.rivals_found == 0);   // no other restart explains the cloud
   CHECK(restarted.certified());
   // Oracle: the truth (the box alone is two-fold symmetric, the bump is not).
   const PointSet queries = StridedColumns(object.sample(), 1000);
@@ -411,4 +413,92 @@ TEST_CASE("re-estimation: a flipped start is refuted, the restart at the half-tu
   CHECK(good.certified());
   CHECK(good.restart_axis == -1);
   CHECK(good.restarts_tried == 0);
+}
+
+TEST_CASE("re-estimation axes: the 13 rotation axes of a cube's symmetries in the principal frame") {
+  const ObjectModel object = BumpedBox();
+  const PrincipalFrame frame = ModelPrincipalFrame(object);
+  const Eigen::Matrix<double, 3, 13> axes = ReestimateAxes(frame);
+  // Oracle: in the principal frame the axes are the 3 coordinate axes, the 6
+  // (±1, ±1, 0)/√2 permutations up to sign and the 4 (1, ±1, ±1)/√3.
+  const Eigen::Matrix<double, 3, 13> local = frame.axes.transpose() * axes;
+  int principal = 0, face = 0, body = 0;
+  for (int a = 0; a < 13; ++a) {
+    CHECK(axes.col(a).norm() == doctest::Approx(1.0));
+    const Eigen::Vector3d v = local.col(a).cwiseAbs();
+    const int zeros = (v.array() < 1e-9).count();
+    if (zeros == 2) ++principal;
+    if (zeros == 1) {
+      ++face;
+      CHECK(v.maxCoeff() == doctest::Approx(std::sqrt(0.5)));
+    }
+    if (zeros == 0) {
+      ++body;
+      CHECK(v.minCoeff() == doctest::Approx(1.0 / std::sqrt(3.0)));
+    }
+    for (int b = 0; b < a; ++b) CHECK(std::abs(axes.col(a).dot(axes.col(b))) < 1.0 - 1e-6);   // no axis twice
+  }
+  CHECK(principal == 3);
+  CHECK(face == 6);
+  CHECK(body == 4);
+}
+
+namespace {
+// Refuses every pose whose translation has x > 0 (a stand-in for a frame's free space).
+struct RefuseRight : RivalFilter {
+  bool Passes(const Pose& scene_from_model, int* violations) const override {
+    *violations = scene_from_model.t.x() > 0 ? 7 : 0;
+    return scene_from_model.t.x() <= 0;
+  }
+};
+}  // namespace
+
+TEST_CASE("re-estimation: a restart that also explains the cloud is a rival of the chosen pose") {
+  const ObjectModel object = BumpedBox();
+  const Pose chosen = TestPose();
+  const PointSet queries = StridedColumns(object.sample(), 1000);
+  const auto fit_at = [&](const Pose& pose, bool ok, bool passes_oc) {
+    RivalFit fit;
+    fit.axis = 4;
+    fit.angle = M_PI;
+    fit.ok = ok;
+    fit.passes_oc = passes_oc;
+    fit.scene_from_model = pose;
+    fit.outliers = 3;
+    return fit;
+  };
+  Pose near = chosen, far_left = chosen, far_right = chosen;
+  near.t.x() += 0.002;
+  far_left.t.x() -= 0.05;
+  far_right.t.x() += 0.05;
+  GlobalUniqueness global;
+  global.rival_distance = 2.0 * object.spec().eps_oc;
+  std::vector<RivalFit> fits = {fit_at(near, true, true), fit_at(far_left, true, false), fit_at(far_left, false, true)};
+  // Oracle: the Hausdorff distances by construction (a pure translation of the
+  // posed model moves it by exactly its length).
+  REQUIRE(PosedModelHausdorff(object, queries, chosen, near) < global.rival_distance);
+  REQUIRE(PosedModelHausdorff(object, queries, chosen, far_left) > global.rival_distance);
+  AddRestartRivals(object, fits, chosen, nullptr, &global);
+  CHECK(global.passed);   // the chosen pose's own basin, a misfit, a failed fit: no rival
+  CHECK(global.rivals_found == 0);
+  CHECK(global.rivals_tried == 3);
+
+  fits.push_back(fit_at(far_left, true, true));
+  fits.push_back(fit_at(far_right, true, true));
+  GlobalUniqueness unfiltered;
+  unfiltered.rival_distance = global.rival_distance;
+  AddRestartRivals(object, fits, chosen, nullptr, &unfiltered);
+  CHECK_FALSE(unfiltered.passed);
+  CHECK(unfiltered.rivals_found == 2);
+  CHECK(unfiltered.rival_passes_oc);
+  CHECK(unfiltered.rival_axis == 4);
+  CHECK(unfiltered.rival_hausdorff == doctest::Approx(0.05).epsilon(0.02));
+
+  const RefuseRight filter;   // the frame refutes the rival on the right, not the one on the left
+  GlobalUniqueness filtered;
+  filtered.rival_distance = global.rival_distance;
+  AddRestartRivals(object, fits, chosen, &filter, &filtered);
+  CHECK_FALSE(filtered.passed);
+  CHECK(filtered.rivals_found == 1);
+  CHECK((filtered.rival_scene_from_model.t - far_left.t).norm() < 1e-12);
 }

@@ -23,6 +23,9 @@ void GlobalUniquenessOptions::Check() const {
     throw std::invalid_argument("global uniqueness rival slack must be in [0, 1)");
   }
   if (rival_extra_min < 0) throw std::invalid_argument("global uniqueness rival slack floor must be >= 0");
+  if (reestimate_steps < 2 || reestimate_steps > 36 || reestimate_steps % 2 != 0) {
+    throw std::invalid_argument("re-estimation steps must be even and in [2, 36]");
+  }
 }
 
 int GlobalUniquenessOptions::RivalSlack(Eigen::Index n) const {
@@ -66,6 +69,23 @@ std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOption
     for (int k = 1; k < options.steps; ++k) hypotheses.emplace_back(axis, 2.0 * M_PI * k / options.steps);
   }
   return hypotheses;
+}
+
+Eigen::Matrix<double, 3, 13> ReestimateAxes(const PrincipalFrame& frame) {
+  const Eigen::Matrix3d& a = frame.axes;
+  Eigen::Matrix<double, 3, 13> axes;
+  int k = 0;
+  for (int i = 0; i < 3; ++i) axes.col(k++) = a.col(i).normalized();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = i + 1; j < 3; ++j) {
+      axes.col(k++) = (a.col(i) + a.col(j)).normalized();
+      axes.col(k++) = (a.col(i) - a.col(j)).normalized();
+    }
+  }
+  for (int s1 : {1, -1}) {
+    for (int s2 : {1, -1}) axes.col(k++) = (a.col(0) + s1 * a.col(1) + s2 * a.col(2)).normalized();
+  }
+  return axes;
 }
 
 std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
@@ -217,6 +237,30 @@ GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet
   }
   global.passed = global.rivals_found == 0;
   return global;
+}
+
+void AddRestartRivals(const ObjectModel& object, const std::vector<RivalFit>& fits, const Pose& scene_from_model,
+                      const RivalFilter* filter, GlobalUniqueness* global) {
+  const PointSet queries = StridedColumns(object.sample(), 1000);
+  global->rivals_tried += static_cast<int>(fits.size());
+  for (const RivalFit& fit : fits) {
+    if (!fit.ok || !fit.passes_oc) continue;
+    const double hausdorff = PosedModelHausdorff(object, queries, scene_from_model, fit.scene_from_model);
+    if (!(hausdorff > global->rival_distance)) continue;   // the chosen pose's own basin
+    int violations = -1;
+    if (filter && !filter->Passes(fit.scene_from_model, &violations)) continue;
+    ++global->rivals_found;
+    if (global->rival_axis >= 0 && global->rival_passes_oc && !(hausdorff > global->rival_hausdorff)) continue;
+    global->rival_axis = fit.axis;
+    global->rival_angle_deg = fit.angle * 180.0 / M_PI;
+    global->rival_hausdorff = hausdorff;
+    global->rival_outliers = fit.outliers;
+    global->rival_budget_distance = fit.budget_distance;
+    global->rival_passes_oc = true;
+    global->rival_free_space_violations = violations;
+    global->rival_scene_from_model = fit.scene_from_model;
+  }
+  global->passed = global->rivals_found == 0;
 }
 
 }  // namespace c3po

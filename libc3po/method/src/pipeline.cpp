@@ -54,12 +54,32 @@ bool Refuted(const Certificate& certificate) {
   return !certificate.fits_observation();
 }
 
+// The restarts of the re-estimation: T̂ turned about the 13 ReestimateAxes
+// through the centroid by k·360°/steps.
+std::vector<RivalStart> ReestimateStarts(const ObjectModel& object, const Pose& scene_from_model, int steps) {
+  const PrincipalFrame frame = ModelPrincipalFrame(object);
+  const Eigen::Matrix<double, 3, 13> axes = ReestimateAxes(frame);
+  std::vector<RivalStart> starts;
+  for (int a = 0; a < axes.cols(); ++a) {
+    for (int k = 1; k < steps; ++k) {
+      const double angle = 2.0 * M_PI * k / steps;
+      Pose turn;
+      turn.R = Eigen::AngleAxisd(angle, Eigen::Vector3d(axes.col(a))).toRotationMatrix();
+      turn.t = frame.centroid - turn.R * frame.centroid;
+      starts.push_back({a, angle, scene_from_model * turn});
+    }
+  }
+  return starts;
+}
+
 // GlobalUniquenessOptions::reestimate: the refuted estimate is replaced by the
-// best restart that passes oc_m and free space, if any.
+// best restart that passes oc_m and free space, if any; a certified
+// replacement must have no other restart as a rival (AddRestartRivals).
 void Reestimate(const ObjectModel& object, const PointSet& cloud, const PipelineOptions& options,
                 const FreeSpaceTest* free_space, PoseEstimate* estimate) {
-  const std::vector<RivalFit> fits = RefineRivals(object, cloud, *estimate, options, ModelPrincipalFrame(object),
-                                                  RivalHypotheses(options.certificate.global));
+  const std::vector<RivalFit> fits =
+      FitRivals(object, cloud, *estimate, options,
+                ReestimateStarts(object, estimate->scene_from_model, options.certificate.global.reestimate_steps), true);
   // Candidates by their outlier count (the rivals' looser budget), best first.
   std::vector<std::size_t> order;
   for (std::size_t i = 0; i < fits.size(); ++i) {
@@ -75,6 +95,12 @@ void Reestimate(const ObjectModel& object, const PointSet& cloud, const Pipeline
     PoseEstimate restarted = EstimateAndCertify(object, cloud, fits[i].start * object.keypoints(), once, free_space);
     if (!restarted.ok() || Refuted(restarted.certificate)) continue;
     restarted.detected_keypoints = estimate->detected_keypoints;
+    if (restarted.certificate.certified() && options.certificate.global.enabled) {
+      NonDegeneracy& nd = restarted.certificate.nd;
+      AddRestartRivals(object, fits, restarted.scene_from_model, free_space, &nd.global);
+      nd.global_checked = true;
+      nd.passed = nd.passed && nd.global.passed;
+    }
     restarted.restart_axis = fits[i].axis;
     restarted.restart_angle_deg = fits[i].angle * 180.0 / M_PI;
     *estimate = std::move(restarted);

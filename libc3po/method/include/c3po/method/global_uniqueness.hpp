@@ -29,13 +29,17 @@ struct PoseEstimate;
 struct GlobalUniquenessOptions {
   bool enabled = true;
   // Re-estimation: when the corrected estimate fails oc_m or free space (it
-  // is refuted), the corrector is restarted at the same turned hypotheses and
-  // the fit with the fewest points beyond eps_oc that passes oc_m and free
-  // space replaces it (and is certified in full, rival search included).
-  // Choosing which pose to certify cannot make a certificate unsound. Off by
-  // default: measured on the real frames it certified 2 more of 200 own
-  // instances and 20 more of 1600 other objects' segments (docs/method.md).
+  // is refuted), the corrector is restarted from T̂ turned by
+  // k·360°/reestimate_steps (k = 1 .. steps-1) about 13 axes through the
+  // centroid (ReestimateStarts: the 3 principal axes, their 6 face diagonals
+  // and 4 body diagonals), and the fit with the fewest points beyond eps_oc
+  // that passes oc_m and free space replaces it (and is certified in full,
+  // rival search included). Choosing which pose to certify cannot make a
+  // certificate unsound; and when another restart that counts as a rival
+  // (the rivals' oc, free space) lies beyond rival_distance of the chosen
+  // one, the search itself found a second explanation: nd.global fails.
   bool reestimate = false;
+  int reestimate_steps = 12;   // even, in [2, 36]
   // Rotations by k·360°/steps about each principal axis, k = 1 .. steps-1
   // (even: the half-turns are included). 4: 90°, 180°, 270° (9 rivals).
   int steps = 4;
@@ -57,7 +61,7 @@ struct GlobalUniquenessOptions {
   int rival_extra_min = 10;
   // The slack in points for a cloud of n points.
   int RivalSlack(Eigen::Index n) const;
-  void Check() const;   // steps even and in [2, 36], rival_distance >= 0 finite, fraction in [0, 1), min >= 0
+  void Check() const;   // steps, reestimate_steps even and in [2, 36], rival_distance >= 0 finite, fraction in [0, 1), min >= 0
 };
 
 // The evidence (part of NonDegeneracy, certificate.hpp).
@@ -117,6 +121,11 @@ std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cl
 // The (axis, angle) hypotheses of the options (3 × (steps - 1)).
 std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOptions& options);
 
+// The 13 axes of the re-estimation (columns, unit): the principal axes (0-2),
+// the face diagonals a_i ± a_j (3-8) and the body diagonals a_0 ± a_1 ± a_2
+// (9-12) -- the rotation axes of a cube's symmetries in the principal frame.
+Eigen::Matrix<double, 3, 13> ReestimateAxes(const PrincipalFrame& frame);
+
 // An extra test a rival must pass to count (the free-space test of depth-image
 // inputs, free_space.hpp): whether the pose passes and its violation count.
 struct RivalFilter {
@@ -170,5 +179,13 @@ WeakMotionCheck CheckWeakMotion(const ObjectModel& object, const PointSet& cloud
 // pipeline's corrector and certificate options.
 GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
                                        const PipelineOptions& pipeline, const RivalFilter* filter = nullptr);
+
+// The re-estimation's own evidence (GlobalUniquenessOptions::reestimate):
+// the restart fits that count as rivals of the chosen pose T̂ (fitted, the
+// rivals' oc, `filter`, Hausdorff(T̂·B̂, T'·B̂) > global->rival_distance) are
+// added to `global` (rivals_tried, rivals_found, the farthest reported when
+// it is farther than the one already there); passed = no rival found.
+void AddRestartRivals(const ObjectModel& object, const std::vector<RivalFit>& fits, const Pose& scene_from_model,
+                      const RivalFilter* filter, GlobalUniqueness* global);
 
 }  // namespace c3po

@@ -28,8 +28,9 @@ struct PoseEstimate {
   double milliseconds = 0.0;      // correction + certification time
   // Re-estimation (GlobalUniquenessOptions::reestimate): the estimate failed
   // oc or free space and the corrector restarted at the turn (axis, angle)
-  // found the pose reported here; axis -1: not re-estimated. The detected
-  // keypoints stay the detector's.
+  // found the pose reported here (axis: a column of ReestimateAxes, 0-2 the
+  // principal axes); axis -1: not re-estimated. The detected keypoints stay
+  // the detector's.
   int restart_axis = -1;
   double restart_angle_deg = 0.0;
   int restarts_tried = 0;
