@@ -74,7 +74,7 @@ SampleResult FromEstimate(std::size_t index, const std::string& cloud, const Pos
   sample.detected_keypoints = estimate.detected_keypoints;
   sample.oc = estimate.certificate.oc.passed;
   sample.nd = estimate.certificate.nd.passed;
-  sample.free_space = !estimate.certificate.free_space.checked || estimate.certificate.free_space.passed;
+  sample.free_space = !estimate.certificate.free_space.refutes();
   sample.oc_distance = estimate.certificate.oc.max_point_distance;
   sample.outlier_indices = estimate.certificate.oc.outlier_indices;
   sample.milliseconds = estimate.milliseconds;
@@ -121,7 +121,7 @@ SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
   const Certificate& certificate = refined.certificate;
   sample.oc = certificate.oc.passed;
   sample.nd = certificate.nd.passed;
-  sample.free_space = !certificate.free_space.checked || certificate.free_space.passed;
+  sample.free_space = !certificate.free_space.refutes();
   sample.oc_distance = certificate.oc.max_point_distance;
   sample.outlier_indices = certificate.oc.outlier_indices;
   sample.milliseconds = registration.milliseconds +

@@ -336,8 +336,12 @@ BopInstances ListBopInstances(const std::string& dir_argument, const BopOptions&
   return result;
 }
 
+DepthImage LoadBopDepth(const BopInstance& instance) {
+  return DepthFromPng(ReadDepthPng(instance.depth_path), instance.camera.depth_scale);
+}
+
 SegmentCloud LoadBopInstance(const BopInstance& instance, const SegmentOptions& options) {
-  const DepthImage depth = DepthFromPng(ReadDepthPng(instance.depth_path), instance.camera.depth_scale);
+  const DepthImage depth = LoadBopDepth(instance);
   Mask mask;
   std::string mask_name = instance.mask_path;
   if (instance.detection) {

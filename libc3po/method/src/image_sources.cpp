@@ -71,15 +71,14 @@ std::vector<BopInstance> ShardBopInstances(const std::vector<BopInstance>& insta
   return part;
 }
 
-DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances,
-                               const SegmentOptions& options) {
+DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances) {
   auto by_cloud = std::make_shared<std::map<std::string, BopInstance>>();
   for (const BopInstance& instance : instances) (*by_cloud)[BopDatasetCloudName(instance)] = instance;
-  return [listed, by_cloud, options](const DatasetEntry& entry) {
+  return [listed, by_cloud](const DatasetEntry& entry) {
     const auto it = by_cloud->find(entry.cloud);
     if (it == by_cloud->end()) return DepthView{};
-    const SegmentCloud segment = LoadBopInstance(it->second, options);
-    return DepthView{segment.depth, segment.camera};
+    // The depth image alone: the segment is the dataset's cloud already.
+    return DepthView{std::make_shared<const DepthImage>(LoadBopDepth(it->second)), it->second.camera.K};
   };
 }
 

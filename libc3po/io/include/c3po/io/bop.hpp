@@ -87,6 +87,8 @@ BopInstances ListBopInstances(const std::string& dir, const BopOptions& options)
 
 // Reads depth + mask of one instance and back-projects it (segment.hpp).
 SegmentCloud LoadBopInstance(const BopInstance& instance, const SegmentOptions& options);
+// The instance's depth image alone (metres), as LoadBopInstance reads it.
+DepthImage LoadBopDepth(const BopInstance& instance);
 
 // The BOP results CSV (bop_toolkit docs/bop_challenge_*.md):
 // header "scene_id,im_id,obj_id,score,R,t,time"; R 9 numbers row-major and t

@@ -108,7 +108,7 @@ struct Certificate {
   FreeSpace free_space;    // checked only for depth-image inputs (free_space.checked)
   // The pose explains what was seen: oc and, for depth-image inputs, free
   // space (nd aside). Failing it refutes an estimate; a pseudo-label needs it.
-  bool fits_observation() const { return oc.passed && (!free_space.checked || free_space.passed); }
+  bool fits_observation() const { return oc.passed && !free_space.refutes(); }
   bool certified() const { return fits_observation() && nd.passed; }
 };
 

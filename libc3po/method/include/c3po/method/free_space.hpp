@@ -44,6 +44,7 @@ struct FreeSpace {
   int measured = 0;            // of those, with a valid observed depth
   int violations = 0;          // of those, observed depth > rendered depth + tolerance
   double tolerance = 0.0;
+  bool refutes() const { return checked && !passed; }   // not checked (no frame) refutes nothing
 };
 
 // The depth frame a segment came from (carried by SegmentCloud).

@@ -73,7 +73,7 @@ struct GlobalUniqueness {
   // The rival reported: the farthest one that counts; if none counts, the
   // distinct one (farther than rival_distance) with the fewest outliers;
   // axis -1 when every rival fell back within rival_distance of T̂.
-  int rival_axis = -1;          // principal axis (0 = largest extent)
+  int rival_axis = -1;          // principal axis (0 = largest extent); a restart's: ReestimateAxes column
   double rival_angle_deg = 0.0; // start rotation about it
   double rival_hausdorff = 0.0; // Hausdorff(T̂·B̂, T'·B̂)
   int rival_outliers = -1;      // its oc_m outlier count (points >= eps_oc)
