@@ -132,6 +132,10 @@ TEST_CASE("malformed object files: InputError naming the file and the field") {
       {"bad_missing_eps_oc.json", "eps_oc"},
       {"bad_missing_delta_nd.json", "delta_nd"},
       {"bad_schema_version_2.json", "schema_version"},
+      // A float where an integer belongs is refused, not converted (1e300 to
+      // int is undefined behaviour; a fuzzer found it).
+      {"bad_schema_version_huge_float.json", "schema_version"},
+      {"bad_schema_version_fraction.json", "schema_version"},
       {"bad_name_not_string.json", "name"},
       {"bad_name_empty.json", "name"},
       {"bad_mesh_not_string.json", "mesh"},
@@ -150,6 +154,8 @@ TEST_CASE("malformed object files: InputError naming the file and the field") {
       {"bad_indicator_empty_set.json", "indicator_sets"},
       {"bad_indicator_not_integer.json", "indicator_sets"},
       {"bad_indicator_huge.json", "indicator_sets"},
+      {"bad_indicator_min_int64.json", "indicator_sets"},
+      {"bad_indicator_max_uint64.json", "indicator_sets"},
       {"bad_indicator_string.json", "indicator_sets"},
       {"bad_eps_oc_negative.json", "eps_oc"},
       {"bad_eps_oc_string.json", "eps_oc"},

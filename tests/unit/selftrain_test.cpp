@@ -206,6 +206,24 @@ TEST_CASE("resuming from a checkpoint gives the uninterrupted result") {
   const SelfTrainResult result = SelfTrain(object, clouds, resumed, options, {}, {}, /*resume=*/true);
   CHECK(result.epochs.size() == 4);
   CHECK(resumed.GetWeights() == straight.GetWeights());
+
+  // A corrupt resume state is an InputError naming the checkpoint: a float
+  // where an integer belongs (converting 1e300 to int would be undefined), a
+  // wrong type, missing fields.
+  for (const std::string state : {R"({"epoch": 1e300})", R"({"epoch": "two"})", R"({"epoch": 1})"}) {
+    options.checkpoint_path = dir / "corrupt.ckpt";
+    OffsetDetector corrupt(start, 0.5);
+    corrupt.SaveCheckpoint(options.checkpoint_path, state);
+    CAPTURE(state);
+    try {
+      SelfTrain(object, clouds, corrupt, options, {}, {}, /*resume=*/true);
+      FAIL_CHECK("a corrupt resume state was accepted");
+    } catch (const c3po::InputError& e) {
+      const std::string message = e.what();
+      CHECK(message.find(options.checkpoint_path) != std::string::npos);
+      CHECK(message.find('\n') == std::string::npos);
+    }
+  }
 }
 
 namespace {

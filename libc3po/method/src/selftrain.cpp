@@ -9,15 +9,18 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <optional>
 #include <stdexcept>
+#include <type_traits>
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/base/interrupt.hpp"
+#include "c3po/base/json.hpp"
 #include "c3po/base/parallel.hpp"
 #include "c3po/method/model_symmetries.hpp"
 #include "c3po/base/random.hpp"
@@ -186,9 +189,23 @@ json LogJson(const SelfTrainEpochLog& log) {
   return j;
 }
 
-SelfTrainEpochLog LogFromJson(const json& j) {
+// One field of a checkpoint's resume state (a reader of a file the user
+// hands back): integers through IntegerInRange, since converting a JSON float
+// such as 1e300 to int is undefined behaviour; other types by nlohmann (its
+// type errors become InputError in ReadResumeState).
+template <class T>
+void ReadStateField(const json& j, const char* key, T* out, const std::string& where) {
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    *out = static_cast<T>(IntegerInRange(j.at(key), std::numeric_limits<int>::min(),
+                                         std::numeric_limits<int>::max(), where, key));
+  } else {
+    j.at(key).get_to(*out);
+  }
+}
+
+SelfTrainEpochLog LogFromJson(const json& j, const std::string& where) {
   SelfTrainEpochLog log;
-#define C3PO_READ(field) j.at(#field).get_to(log.field);
+#define C3PO_READ(field) ReadStateField(j, #field, &log.field, where);
   C3PO_SELFTRAIN_LOG_FIELDS(C3PO_READ)
 #undef C3PO_READ
   return log;
@@ -202,17 +219,17 @@ json FitJson(const ValidationFit& f) {
           {"hausdorff_median", f.hausdorff_median}};
 }
 
-ValidationFit FitFromJson(const json& j) {
+ValidationFit FitFromJson(const json& j, const std::string& where) {
   ValidationFit f;
-  j.at("percent_oc").get_to(f.percent_oc);
-  j.at("percent_certified").get_to(f.percent_certified);
-  j.at("percent_identified").get_to(f.percent_identified);
-  j.at("ambiguous").get_to(f.ambiguous);
-  j.at("detection_error").get_to(f.detection_error);
-  j.at("residual_q50").get_to(f.residual_q50);
-  j.at("residual_q90").get_to(f.residual_q90);
-  j.at("rotation_error_median").get_to(f.rotation_error_median);
-  j.at("hausdorff_median").get_to(f.hausdorff_median);
+  ReadStateField(j, "percent_oc", &f.percent_oc, where);
+  ReadStateField(j, "percent_certified", &f.percent_certified, where);
+  ReadStateField(j, "percent_identified", &f.percent_identified, where);
+  ReadStateField(j, "ambiguous", &f.ambiguous, where);
+  ReadStateField(j, "detection_error", &f.detection_error, where);
+  ReadStateField(j, "residual_q50", &f.residual_q50, where);
+  ReadStateField(j, "residual_q90", &f.residual_q90, where);
+  ReadStateField(j, "rotation_error_median", &f.rotation_error_median, where);
+  ReadStateField(j, "hausdorff_median", &f.hausdorff_median, where);
   return f;
 }
 
@@ -373,18 +390,27 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   int stale = 0;   // epochs in a row without a new best
   const std::string best_path = options.checkpoint_path + ".best";
   if (resume && !options.checkpoint_path.empty() && std::filesystem::exists(options.checkpoint_path)) {
-    const json state = json::parse(detector.LoadCheckpoint(options.checkpoint_path));
-    first_epoch = state.at("epoch").get<int>() + 1;
-    result.best_epoch = state.at("best_epoch");
-    result.best_validation_percent_oc = state.at("best_validation_percent_oc");
-    result.best_validation_detection_error = state.at("best_validation_detection_error");
-    result.initial_validation_percent_oc = state.at("initial_validation_percent_oc");
-    result.initial = FitFromJson(state.at("initial"));
-    result.best = FitFromJson(state.at("best"));
-    stale = state.at("stale");
-    for (const auto& log : state.at("logs")) result.epochs.push_back(LogFromJson(log));
-    if (state.contains("pseudo_label_uses") && state.at("pseudo_label_uses").size() == clouds.size()) {
-      state.at("pseudo_label_uses").get_to(result.pseudo_label_uses);
+    const std::string& where = options.checkpoint_path;
+    try {
+      const json state = json::parse(detector.LoadCheckpoint(where));
+      ReadStateField(state, "epoch", &first_epoch, where);
+      first_epoch += 1;
+      ReadStateField(state, "best_epoch", &result.best_epoch, where);
+      ReadStateField(state, "best_validation_percent_oc", &result.best_validation_percent_oc, where);
+      ReadStateField(state, "best_validation_detection_error", &result.best_validation_detection_error, where);
+      ReadStateField(state, "initial_validation_percent_oc", &result.initial_validation_percent_oc, where);
+      result.initial = FitFromJson(state.at("initial"), where);
+      result.best = FitFromJson(state.at("best"), where);
+      ReadStateField(state, "stale", &stale, where);
+      for (const auto& log : state.at("logs")) result.epochs.push_back(LogFromJson(log, where));
+      if (state.contains("pseudo_label_uses") && state.at("pseudo_label_uses").size() == clouds.size()) {
+        for (std::size_t i = 0; i < clouds.size(); ++i) {
+          result.pseudo_label_uses[i] = static_cast<int>(IntegerInRange(
+              state.at("pseudo_label_uses")[i], 0, std::numeric_limits<int>::max(), where, "pseudo_label_uses"));
+        }
+      }
+    } catch (const json::exception& e) {
+      throw InputError(where, std::string("corrupt self-training state: ") + e.what());
     }
     best_weights = LoadWeights(best_path, detector.GetWeights().size());
   } else {

@@ -3,7 +3,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -63,11 +62,7 @@ std::vector<std::vector<int>> ParseIndicatorSets(const json& value, const std::s
     if (!value[s].is_array()) throw InputError(where, name + ": expected a list of keypoint indices");
     std::vector<int> set;
     for (const json& index : value[s]) {
-      if (!index.is_number_integer()) throw InputError(where, name + ": keypoint index " + index.dump() + " is not an integer");
-      const bool fits = index.is_number_unsigned() ? index.get<std::uint64_t>() <= 1000000000ULL
-                                                   : std::llabs(index.get<std::int64_t>()) <= 1000000000LL;
-      if (!fits) throw InputError(where, name + ": keypoint index " + index.dump() + " out of range");
-      set.push_back(index.get<int>());
+      set.push_back(static_cast<int>(IntegerInRange(index, -1000000000LL, 1000000000LL, where, name + ": keypoint index")));
     }
     sets.push_back(std::move(set));
   }
@@ -92,7 +87,8 @@ ObjectSpec ReadObjectSpec(const std::string& path) {
   }
   if (!doc.is_object()) throw InputError(path, "expected a JSON object");
   ObjectSpec spec;
-  spec.schema_version = Required<int>(doc, "schema_version", path);
+  if (!doc.contains("schema_version")) throw InputError(path, "schema_version: missing");
+  spec.schema_version = static_cast<int>(IntegerInRange(doc["schema_version"], 0, 1000000, path, "schema_version"));
   spec.name = Required<std::string>(doc, "name", path);
   const std::string mesh = Required<std::string>(doc, "mesh", path);
   if (mesh.empty()) throw InputError(path, "mesh: empty path");

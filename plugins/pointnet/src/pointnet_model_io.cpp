@@ -1,11 +1,14 @@
 // PointNetDetector's model and checkpoint files (format in pointnet.hpp).
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
+#include "c3po/base/json.hpp"
 #include "detector_impl.hpp"
 #include "model_file.hpp"
 
@@ -25,14 +28,18 @@ double NumberOrNaN(const json& value) {
   return value.is_number() ? value.get<double>() : std::nan("");
 }
 
-EpochLog EpochFromJson(const json& j) {
+int IntField(const json& j, const char* key, const std::string& path) {
+  return static_cast<int>(IntegerInRange(j.at(key), 0, std::numeric_limits<int>::max(), path, key));
+}
+
+EpochLog EpochFromJson(const json& j, const std::string& path) {
   EpochLog log;
-  log.epoch = j.at("epoch").get<int>();
+  log.epoch = IntField(j, "epoch", path);
   log.train_loss = NumberOrNaN(j.at("train_loss"));
   log.val_loss = NumberOrNaN(j.at("val_loss"));
   log.val_keypoint_error = NumberOrNaN(j.at("val_keypoint_error"));
   log.seconds = j.at("seconds").get<double>();
-  if (j.contains("labellings_switched")) log.labellings_switched = j.at("labellings_switched").get<int>();
+  if (j.contains("labellings_switched")) log.labellings_switched = IntField(j, "labellings_switched", path);
   log.best = j.at("best").get<bool>();
   return log;
 }
@@ -135,7 +142,7 @@ void RestoreCheckpoint(const json& header, pointnet::BinaryReader* reader, const
   const json& progress = Field(header, "progress", json::value_t::object, path);
   try {
     const std::string kind = optimizer.at("kind").get<std::string>();
-    const std::string state = reader->Raw(optimizer.at("state_bytes").get<std::size_t>(), "optimizer state");
+    const std::string state = reader->Raw(static_cast<std::size_t>(IntegerInRange(optimizer.at("state_bytes"), 0, std::numeric_limits<std::int64_t>::max(), path, "state_bytes")), "optimizer state");
     if (!kind.empty()) {
       PointNetTrainOptions options;
       options.optimizer = kind;
@@ -146,13 +153,13 @@ void RestoreCheckpoint(const json& header, pointnet::BinaryReader* reader, const
       if (!impl->optimizer->LoadState(in)) throw InputError(path, "corrupt checkpoint: optimizer state");
     }
     PointNetProgress& p = impl->progress;
-    p.epochs_done = progress.at("epochs_done").get<int>();
-    p.best_epoch = progress.at("best_epoch").get<int>();
+    p.epochs_done = IntField(progress, "epochs_done", path);
+    p.best_epoch = IntField(progress, "best_epoch", path);
     p.best_val_loss = progress.at("best_val_loss").is_number()
                           ? progress.at("best_val_loss").get<double>()
                           : std::numeric_limits<double>::infinity();
-    for (const auto& log : progress.at("history")) p.history.push_back(EpochFromJson(log));
-    p.best_weights = reader->Floats(progress.at("best_weights").get<std::size_t>(), "best weights");
+    for (const auto& log : progress.at("history")) p.history.push_back(EpochFromJson(log, path));
+    p.best_weights = reader->Floats(static_cast<std::size_t>(IntegerInRange(progress.at("best_weights"), 0, std::numeric_limits<std::int64_t>::max(), path, "best_weights")), "best weights");
     if (header.contains("state") && header["state"].is_string()) {
       impl->checkpoint_state = header["state"].get<std::string>();
     }

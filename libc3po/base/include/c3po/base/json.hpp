@@ -3,8 +3,11 @@
 // (certify lines, manifests, object files, evaluation JSON, pages): a point
 // set is a list of [x, y, z] rows, a pose is "R" (three rows) and "t".
 // Json is nlohmann::json or nlohmann::ordered_json (key order of a schema).
+#include <cstdint>
 #include <nlohmann/json.hpp>
+#include <string>
 
+#include "c3po/base/error.hpp"
 #include "c3po/base/types.hpp"
 
 namespace c3po {
@@ -34,6 +37,24 @@ template <class Json>
 void SetPoseJson(const Pose& pose, Json* json) {
   (*json)["R"] = RotationToJson<Json>(pose.R);
   (*json)["t"] = VectorToJson<Json>(pose.t);
+}
+
+// A JSON integer within [lo, hi], else InputError(where, "field: ..."). JSON
+// floats are refused, not converted: 1e300 converted to int is undefined
+// behaviour, and 1.5 must not be truncated silently.
+template <class Json = nlohmann::json>
+long long IntegerInRange(const Json& value, long long lo, long long hi, const std::string& where,
+                         const std::string& field) {
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!value.is_number_integer()) {
+    throw InputError(where, field + ": " + value.dump() + " is not an integer (expected one in " + range + ")");
+  }
+  const bool in_range = value.is_number_unsigned()
+                            ? hi >= 0 && value.template get<std::uint64_t>() <= static_cast<std::uint64_t>(hi) &&
+                                  (lo <= 0 || value.template get<std::uint64_t>() >= static_cast<std::uint64_t>(lo))
+                            : value.template get<std::int64_t>() >= lo && value.template get<std::int64_t>() <= hi;
+  if (!in_range) throw InputError(where, field + ": " + value.dump() + " out of range " + range);
+  return value.template get<long long>();
 }
 
 }  // namespace c3po
