@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <tuple>
 #include <algorithm>
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "c3po/base/error.hpp"
+#include "c3po/base/json.hpp"
 #include "c3po/geometry/mesh.hpp"
 #include "c3po/io/mesh_io.hpp"
 #include "c3po/object/object_io.hpp"
@@ -221,4 +223,37 @@ TEST_CASE("the CLI turns malformed object and mesh files into exit status 2 and 
     CHECK(std::count(result.output.begin(), result.output.end(), '\n') == 1);
   }
   CHECK_FALSE(fs::exists(dir / "out.json"));  // nothing written on failure
+}
+
+TEST_CASE("IntegerInRange: JSON integers within the range pass, floats and values outside are refused") {
+  using nlohmann::json;
+  const auto read = [](const json& value, long long lo, long long hi) {
+    return c3po::IntegerInRange(value, lo, hi, "file.json", "field");
+  };
+  CHECK(read(json(5), 0, 10) == 5);
+  CHECK(read(json(-3), -5, 5) == -3);
+  CHECK(read(json(10u), 0, 10) == 10);   // unsigned JSON integer at the upper bound
+  CHECK(read(json(0u), 0, 10) == 0);
+  CHECK(read(json::parse("-9223372036854775808"), std::numeric_limits<long long>::min(), 0) ==
+        std::numeric_limits<long long>::min());
+  for (const json& bad : {json(5.0), json(1e300), json(-1e300), json(0.5), json("5"), json(nullptr), json::array(),
+                          json(11), json(-1), json(11u), json::parse("18446744073709551615"),
+                          json::parse("-9223372036854775808")}) {
+    CAPTURE(bad.dump());
+    try {
+      read(bad, 0, 10);
+      FAIL_CHECK("accepted");
+    } catch (const c3po::InputError& e) {
+      const std::string message = e.what();
+      CHECK(message.rfind("file.json: field: ", 0) == 0);
+      CHECK(message.find('\n') == std::string::npos);
+    }
+  }
+  // The message quotes at most 40 characters of the value.
+  try {
+    read(json(std::vector<int>(1000, 7)), 0, 10);
+    FAIL_CHECK("accepted");
+  } catch (const c3po::InputError& e) {
+    CHECK(std::string(e.what()).size() < 150);
+  }
 }

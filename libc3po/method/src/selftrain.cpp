@@ -192,7 +192,8 @@ json LogJson(const SelfTrainEpochLog& log) {
 // One field of a checkpoint's resume state (a reader of a file the user
 // hands back): integers through IntegerInRange, since converting a JSON float
 // such as 1e300 to int is undefined behaviour; other types by nlohmann (its
-// type errors become InputError in ReadResumeState).
+// type errors become an InputError naming the checkpoint where SelfTrain
+// reads the state).
 template <class T>
 void ReadStateField(const json& j, const char* key, T* out, const std::string& where) {
   if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
