@@ -404,10 +404,11 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
       result.best = FitFromJson(state.at("best"), where);
       ReadStateField(state, "stale", &stale, where);
       for (const auto& log : state.at("logs")) result.epochs.push_back(LogFromJson(log, where));
-      if (state.contains("pseudo_label_uses") && state.at("pseudo_label_uses").size() == clouds.size()) {
-        for (std::size_t i = 0; i < clouds.size(); ++i) {
-          result.pseudo_label_uses[i] = static_cast<int>(IntegerInRange(
-              state.at("pseudo_label_uses")[i], 0, std::numeric_limits<int>::max(), where, "pseudo_label_uses"));
+      const json uses = state.value("pseudo_label_uses", json::array());
+      if (uses.size() == clouds.size()) {
+        for (std::size_t i = 0; i < uses.size(); ++i) {
+          result.pseudo_label_uses[i] =
+              static_cast<int>(IntegerInRange(uses[i], 0, std::numeric_limits<int>::max(), where, "pseudo_label_uses"));
         }
       }
     } catch (const json::exception& e) {

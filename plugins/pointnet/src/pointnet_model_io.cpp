@@ -32,6 +32,10 @@ int IntField(const json& j, const char* key, const std::string& path) {
   return static_cast<int>(IntegerInRange(j.at(key), 0, std::numeric_limits<int>::max(), path, key));
 }
 
+std::size_t SizeField(const json& j, const char* key, const std::string& path) {
+  return static_cast<std::size_t>(IntegerInRange(j.at(key), 0, std::numeric_limits<std::int64_t>::max(), path, key));
+}
+
 EpochLog EpochFromJson(const json& j, const std::string& path) {
   EpochLog log;
   log.epoch = IntField(j, "epoch", path);
@@ -142,7 +146,7 @@ void RestoreCheckpoint(const json& header, pointnet::BinaryReader* reader, const
   const json& progress = Field(header, "progress", json::value_t::object, path);
   try {
     const std::string kind = optimizer.at("kind").get<std::string>();
-    const std::string state = reader->Raw(static_cast<std::size_t>(IntegerInRange(optimizer.at("state_bytes"), 0, std::numeric_limits<std::int64_t>::max(), path, "state_bytes")), "optimizer state");
+    const std::string state = reader->Raw(SizeField(optimizer, "state_bytes", path), "optimizer state");
     if (!kind.empty()) {
       PointNetTrainOptions options;
       options.optimizer = kind;
@@ -159,7 +163,7 @@ void RestoreCheckpoint(const json& header, pointnet::BinaryReader* reader, const
                           ? progress.at("best_val_loss").get<double>()
                           : std::numeric_limits<double>::infinity();
     for (const auto& log : progress.at("history")) p.history.push_back(EpochFromJson(log, path));
-    p.best_weights = reader->Floats(static_cast<std::size_t>(IntegerInRange(progress.at("best_weights"), 0, std::numeric_limits<std::int64_t>::max(), path, "best_weights")), "best weights");
+    p.best_weights = reader->Floats(SizeField(progress, "best_weights", path), "best weights");
     if (header.contains("state") && header["state"].is_string()) {
       impl->checkpoint_state = header["state"].get<std::string>();
     }

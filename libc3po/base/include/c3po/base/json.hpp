@@ -45,19 +45,19 @@ void SetPoseJson(const Pose& pose, Json* json) {
 template <class Json = nlohmann::json>
 long long IntegerInRange(const Json& value, long long lo, long long hi, const std::string& where,
                          const std::string& field) {
-  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
   const auto shown = [&value] {   // one line; a huge value is cut
     const std::string text = value.dump();
     return text.size() > 40 ? text.substr(0, 37) + "..." : text;
   };
+  const auto range = [lo, hi] { return "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]"; };
   if (!value.is_number_integer()) {
-    throw InputError(where, field + ": " + shown() + " is not an integer (expected one in " + range + ")");
+    throw InputError(where, field + ": " + shown() + " is not an integer (expected one in " + range() + ")");
   }
   const bool in_range = value.is_number_unsigned()
                             ? hi >= 0 && value.template get<std::uint64_t>() <= static_cast<std::uint64_t>(hi) &&
                                   (lo <= 0 || value.template get<std::uint64_t>() >= static_cast<std::uint64_t>(lo))
                             : value.template get<std::int64_t>() >= lo && value.template get<std::int64_t>() <= hi;
-  if (!in_range) throw InputError(where, field + ": " + shown() + " out of range " + range);
+  if (!in_range) throw InputError(where, field + ": " + shown() + " out of range " + range());
   return value.template get<long long>();
 }
 
