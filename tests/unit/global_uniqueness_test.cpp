@@ -163,9 +163,9 @@ struct Frame {
   Pose truth;
 };
 
-Frame RenderFrame(const ObjectModel& object) {
+Frame RenderFrame(const ObjectModel& object, const Pose& truth = TestPose()) {
   Frame frame;
-  frame.truth = TestPose();
+  frame.truth = truth;
   CameraIntrinsics camera;
   DepthRenderer renderer(camera);
   renderer.Render(object.mesh(), frame.truth);
@@ -241,6 +241,60 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   CHECK(e.certificate.free_space.checked);
   CHECK_FALSE(e.certificate.free_space.passed);
   CHECK_FALSE(e.certified());
+}
+
+TEST_CASE("free space: the whole silhouette shifts together (a pose within the tolerance passes, a turn that overhangs two sides fails)") {
+  // A 11 x 9 x 3.5 cm box (a pudding box) seen almost face-on at 0.6 m in
+  // front of a wall: the tolerance is 1 cm, so a pose 1 cm off moves the
+  // image by at most f * 1 cm / z ~ 9 px.
+  const ObjectModel box = PlainBox({0.11, 0.09, 0.035});
+  Pose truth;
+  truth.R = Eigen::AngleAxisd(0.15, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  truth.t = {0.01, -0.02, 0.6};
+  const Frame frame = RenderFrame(box, truth);
+  const FreeSpaceOptions options;
+  const FreeSpaceTest test(box, frame.view, options, box.spec().eps_oc);
+  const FreeSpace at_truth = test.Check(truth);
+  REQUIRE(at_truth.checked);
+  CHECK(at_truth.passed);
+  CHECK(at_truth.violations == 0);
+  CHECK(at_truth.shift_u == 0);
+  CHECK(at_truth.shift_v == 0);
+  const double focal = frame.view.camera.fx;
+  double nearest = truth.t.z();
+  for (Eigen::Index j = 0; j < box.mesh().vertices.cols(); ++j) nearest = std::min(nearest, (truth.R * box.mesh().vertices.col(j) + truth.t).z());
+  CHECK(at_truth.reach == static_cast<int>(std::ceil(focal * at_truth.tolerance / nearest)));
+
+  // Moved sideways by (6, -4) mm: the best shift brings the rendering back
+  // by f * delta / z pixels (the face at ~0.6 m), up to the border of
+  // counted pixels (any shift that keeps them over the box has no violation;
+  // ties go to the smaller shift), and the pose passes.
+  Pose moved = truth;
+  moved.t += Eigen::Vector3d(0.006, -0.004, 0.0);
+  const FreeSpace near = test.Check(moved);
+  CHECK(near.passed);
+  const double slack = options.border_pixels + 1.0;
+  CHECK(std::abs(near.shift_u + focal * 0.006 / truth.t.z()) <= slack);
+  CHECK(std::abs(near.shift_v - focal * 0.004 / truth.t.z()) <= slack);
+  CHECK(near.shift_u < 0);
+  CHECK(near.shift_v > 0);
+  CHECK(near.violations <= 0.01 * near.measured);
+
+  // Turned by 90 deg about the camera axis through the box: 9 x 11 cm over
+  // an 11 x 9 cm face, 1 cm over the wall on two opposite sides. Each side
+  // alone is within reach of some shift; no one shift explains both.
+  Pose turned = truth;
+  turned.R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix() * truth.R;
+  const FreeSpace overhang = test.Check(turned);
+  CHECK_FALSE(overhang.passed);
+  CHECK(overhang.violations > options.max_fraction * overhang.measured);
+
+  // Moved 3 cm sideways: beyond the reach of any shift.
+  Pose far = truth;
+  far.t.x() += 0.03;
+  const FreeSpace beyond = test.Check(far);
+  CHECK_FALSE(beyond.passed);
+  CHECK(std::max(std::abs(beyond.shift_u), std::abs(beyond.shift_v)) <= beyond.reach);
 }
 
 TEST_CASE("global uniqueness: the rival slack has a floor in points (few discriminating points on a small cloud)") {

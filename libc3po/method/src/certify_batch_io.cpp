@@ -119,6 +119,7 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["free_space_measured"] = f.measured;
   line["free_space_silhouette"] = f.silhouette;
   line["free_space_tolerance"] = f.tolerance;
+  line["free_space_shift_px"] = {f.shift_u, f.shift_v};
   line["ms"] = e.milliseconds;
 }
 

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 #include <stdexcept>
 
 namespace c3po {
@@ -29,6 +31,73 @@ FreeSpaceTest::FreeSpaceTest(const ObjectModel& object, DepthView view, const Fr
   }
 }
 
+namespace {
+
+// A rendered pixel the test counts: where it is, and the depth behind which
+// an observation is a violation (the farthest rendered depth among the
+// samples at r and r/2 around it, plus the tolerance).
+struct CountedPixel {
+  int u, v;
+  float limit;
+};
+
+struct ShiftCount {
+  int du = 0, dv = 0;
+  int measured = 0, violations = 0;
+};
+
+// The pixels of the rendered silhouette at least `border` pixels inside it
+// (all samples at `border` covered), each with its violation limit (samples
+// within r that are covered; an uncovered one is the silhouette's edge, which
+// the image shift accounts for).
+std::vector<CountedPixel> CountedPixels(const DepthRenderer& renderer, int w, int h, int border, double focal,
+                                        double tolerance, double* nearest) {
+  std::vector<CountedPixel> counted;
+  *nearest = std::numeric_limits<double>::infinity();
+  const auto covered = [&](int u, int v) { return u >= 0 && v >= 0 && u < w && v < h && renderer.TriangleAt(u, v) >= 0; };
+  for (const int pixel : renderer.covered_pixels()) {
+    const int u = pixel % w, v = pixel / w;
+    const double z = renderer.DepthAt(u, v);
+    *nearest = std::min(*nearest, z);
+    bool interior = true;
+    for (int du = -border; du <= border && interior; du += std::max(border, 1)) {
+      for (int dv = -border; dv <= border && interior; dv += std::max(border, 1)) interior = covered(u + du, v + dv);
+    }
+    if (!interior) continue;
+    const int r = border + static_cast<int>(std::ceil(focal * tolerance / std::max(z, 1e-3)));
+    double farthest = z;
+    for (const int step : {r, (r + 1) / 2}) {
+      for (int du = -step; du <= step; du += step) {
+        for (int dv = -step; dv <= step; dv += step) {
+          if (covered(u + du, v + dv)) farthest = std::max(farthest, renderer.DepthAt(u + du, v + dv));
+        }
+      }
+    }
+    counted.push_back({u, v, static_cast<float>(farthest + tolerance)});
+  }
+  return counted;
+}
+
+ShiftCount CountAtShift(const std::vector<CountedPixel>& counted, const DepthImage& depth, int du, int dv) {
+  ShiftCount count;
+  count.du = du;
+  count.dv = dv;
+  for (const CountedPixel& p : counted) {
+    const int u = p.u + du, v = p.v + dv;
+    if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) continue;
+    const float observed = depth.at(u, v);
+    if (!DepthImage::Valid(observed)) continue;
+    ++count.measured;
+    if (observed > p.limit) ++count.violations;
+  }
+  return count;
+}
+
+// Violations beyond the allowed fraction (<= 0 passes): what the shift search minimises.
+double Excess(const ShiftCount& c, double max_fraction) { return c.violations - max_fraction * c.measured; }
+
+}  // namespace
+
 FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   FreeSpace result;
   result.tolerance = tolerance_;
@@ -36,38 +105,42 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   result.checked = true;
   renderer_->Render(object_.mesh(), camera_from_model);
   const DepthImage& depth = *view_.depth;
-  const int w = depth.width, h = depth.height;
   const double focal = std::max(view_.camera.fx, view_.camera.fy);
-  // A pose within the tolerance shifts the image of the model by at most
-  // r = border_pixels + f·τ/z pixels, so a pixel is a violation only when no
-  // such shift explains it: its observed depth lies behind the FARTHEST
-  // rendered depth among samples within r (at r and r/2 around it, all
-  // covered: pixels near the silhouette's edge are not counted). Curved
-  // surfaces and self-occlusion edges (a mug's rim over its inside) are
-  // thereby explained, not excluded.
-  for (const int pixel : renderer_->covered_pixels()) {
-    const int u = pixel % w, v = pixel / w;
-    const double z = renderer_->DepthAt(u, v);
-    const int r = options_.border_pixels + static_cast<int>(std::ceil(focal * tolerance_ / std::max(z, 1e-3)));
-    bool interior = true;
-    double farthest = z;
-    for (const int step : {r, (r + 1) / 2}) {
-      for (int du = -step; du <= step && interior; du += step) {
-        for (int dv = -step; dv <= step && interior; dv += step) {
-          const int uu = u + du, vv = v + dv;
-          interior = uu >= 0 && vv >= 0 && uu < w && vv < h && renderer_->TriangleAt(uu, vv) >= 0;
-          if (interior) farthest = std::max(farthest, renderer_->DepthAt(uu, vv));
-        }
-      }
-    }
-    if (!interior) continue;
-    ++result.silhouette;
-    const float observed = depth.at(u, v);
-    if (!DepthImage::Valid(observed)) continue;
-    ++result.measured;
-    if (observed > farthest + tolerance_) ++result.violations;
+  double nearest = 0.0;
+  const std::vector<CountedPixel> counted =
+      CountedPixels(*renderer_, depth.width, depth.height, options_.border_pixels, focal, tolerance_, &nearest);
+  result.silhouette = static_cast<int>(counted.size());
+  if (counted.empty()) return result;
+  // A pose within τ of one that explains the frame moves the model's image
+  // by at most R = f·τ/z_nearest pixels, all of it together: the test is
+  // passed when SOME shift of the whole silhouette within R explains the
+  // frame (coarse grid, then every pixel around the best coarse shift).
+  const int reach = static_cast<int>(std::ceil(focal * tolerance_ / std::max(nearest, 1e-3)));
+  const int coarse = std::max(1, (reach + 3) / 4);
+  ShiftCount best = CountAtShift(counted, depth, 0, 0);
+  // Ties go to the smaller shift (the evidence then says how far the pose is off, not where a tie fell).
+  const auto better = [&](const ShiftCount& a, const ShiftCount& b) {
+    const double ea = Excess(a, options_.max_fraction), eb = Excess(b, options_.max_fraction);
+    return ea < eb || (ea == eb && std::abs(a.du) + std::abs(a.dv) < std::abs(b.du) + std::abs(b.dv));
+  };
+  const auto consider = [&](int du, int dv) {
+    if (std::max(std::abs(du), std::abs(dv)) > reach) return;
+    const ShiftCount c = CountAtShift(counted, depth, du, dv);
+    if (better(c, best)) best = c;
+  };
+  for (int du = -reach; du <= reach; du += coarse) {
+    for (int dv = -reach; dv <= reach; dv += coarse) consider(du, dv);
   }
-  result.passed = result.violations <= options_.max_fraction * result.measured;
+  const int cu = best.du, cv = best.dv;
+  for (int du = cu - coarse + 1; du < cu + coarse && coarse > 1; ++du) {
+    for (int dv = cv - coarse + 1; dv < cv + coarse; ++dv) consider(du, dv);
+  }
+  result.measured = best.measured;
+  result.violations = best.violations;
+  result.shift_u = best.du;
+  result.shift_v = best.dv;
+  result.reach = reach;
+  result.passed = Excess(best, options_.max_fraction) <= 0.0;
   return result;
 }
 

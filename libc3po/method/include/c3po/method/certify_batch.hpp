@@ -162,7 +162,7 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   rival_passes_oc, rival_free_space_violations (-1: not checked); free space
 //   (free_space.hpp; depth-image inputs): free_space (null when not checked),
 //   free_space_violations, free_space_measured, free_space_silhouette,
-//   free_space_tolerance; and last ms. Image-source lines also carry
+//   free_space_tolerance, free_space_shift_px; and last ms. Image-source lines also carry
 //   gt_hausdorff after gt_t (Hausdorff(T*·B̂, T̂·B̂), metres) when the
 //   ground truth is known.
 constexpr std::size_t kMaxListedOutliers = 100;

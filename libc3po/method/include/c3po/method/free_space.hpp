@@ -4,16 +4,22 @@
 // camera the segment came from; a pixel inside the rendered silhouette whose
 // observed depth is valid and lies BEHIND the rendered surface by more than
 // `tolerance` is a ray the camera saw through where the (opaque) object would
-// be. Occluders in front are fine; pixels without depth are unknown. The
-// test passes when such pixels are at most `max_fraction` of the silhouette
-// pixels that have a measurement. A pose within the tolerance shifts the
-// image by at most r = border_pixels + f·tolerance/z pixels: pixels within r
-// of the silhouette's edge are not counted, and a pixel violates only when
-// its observed depth is behind the farthest rendered depth within r (plus
-// the tolerance), so self-occlusion edges (a mug's rim over its inside) and
-// curved surfaces do not fail correct poses. Used on the estimate
-// (Certificate::free_space) and on every rival of the global test (a rival
-// that violates free space is not a rival).
+// be. Occluders in front are fine; pixels without depth are unknown. A pose
+// within the tolerance τ of one that explains the frame moves the model's
+// image by at most R = f·τ/z_nearest pixels, all of it together: the test
+// searches the image shifts s (|s|∞ ≤ R) of the whole silhouette and passes
+// when at some shift the violations are at most `max_fraction` of the
+// counted pixels that have a measurement. Counted are the silhouette's pixels
+// at least `border_pixels` inside it (flying pixels and mask edges); a pixel
+// violates only when its observed depth is behind the farthest rendered
+// depth within r = border_pixels + f·τ/z around it (plus τ), so
+// self-occlusion edges (a mug's rim over its inside) and curved surfaces do
+// not fail correct poses. One shift for the whole silhouette, not one per
+// pixel: a pose whose silhouette overhangs the observed object on two
+// opposite sides (a box turned by 90°, 1 cm too long at each end) is
+// refuted, which excluding every pixel within r of the edge could not see.
+// Used on the estimate (Certificate::free_space) and on every rival of the
+// global test (a rival that violates free space is not a rival).
 #include <memory>
 #include <optional>
 
@@ -40,9 +46,11 @@ struct FreeSpaceOptions {
 struct FreeSpace {
   bool checked = false;
   bool passed = true;
-  int silhouette = 0;          // interior pixels of the rendered silhouette
-  int measured = 0;            // of those, with a valid observed depth
-  int violations = 0;          // of those, observed depth > rendered depth + tolerance
+  int silhouette = 0;          // counted pixels of the rendered silhouette (>= border_pixels inside it)
+  int measured = 0;            // of those, at the best shift, with a valid observed depth
+  int violations = 0;          // of those, observed depth behind the rendered surface + tolerance
+  int shift_u = 0, shift_v = 0;  // the best image shift (pixels) of the silhouette
+  int reach = 0;               // the largest shift searched: f·tolerance/z_nearest pixels
   double tolerance = 0.0;
   bool refutes() const { return checked && !passed; }   // not checked (no frame) refutes nothing
 };
