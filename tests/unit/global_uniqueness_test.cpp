@@ -295,6 +295,21 @@ TEST_CASE("free space: the whole silhouette shifts together (a pose within the t
   const FreeSpace beyond = test.Check(far);
   CHECK_FALSE(beyond.passed);
   CHECK(std::max(std::abs(beyond.shift_u), std::abs(beyond.shift_v)) <= beyond.reach);
+
+  // Close up (0.25 m) the reach is ~23 px and the search coarse-to-fine
+  // (grid step 6, then compass steps 3, 2, 1): a pose 8 mm off still finds
+  // its shift, f * 8 mm / z ~ 17 px.
+  Pose close = truth;
+  close.t = {0.0, 0.0, 0.25};
+  const Frame near_frame = RenderFrame(box, close);
+  const FreeSpaceTest near_test(box, near_frame.view, options, box.spec().eps_oc);
+  Pose close_moved = close;
+  close_moved.t.y() += 0.008;
+  const FreeSpace close_check = near_test.Check(close_moved);
+  CHECK(close_check.reach > 20);
+  CHECK(close_check.passed);
+  CHECK(std::abs(close_check.shift_u) <= slack);
+  CHECK(std::abs(close_check.shift_v + focal * 0.008 / close.t.z()) <= slack);
 }
 
 namespace {

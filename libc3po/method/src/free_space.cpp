@@ -114,9 +114,9 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   // A pose within τ of one that explains the frame moves the model's image
   // by at most R = f·τ/z_nearest pixels, all of it together: the test is
   // passed when SOME shift of the whole silhouette within R explains the
-  // frame (coarse grid, then every pixel around the best coarse shift).
+  // frame. Search: a grid of step g = ⌈R/4⌉ over [-R, R]² (0 included), then
+  // a compass search around the best with steps halving down to one pixel.
   const int reach = static_cast<int>(std::ceil(focal * tolerance_ / std::max(nearest, 1e-3)));
-  const int coarse = std::max(1, (reach + 3) / 4);
   ShiftCount best = CountAtShift(counted, depth, 0, 0);
   // Ties go to the smaller shift (the evidence then says how far the pose is off, not where a tie fell).
   const auto better = [&](const ShiftCount& a, const ShiftCount& b) {
@@ -124,16 +124,26 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
     return ea < eb || (ea == eb && std::abs(a.du) + std::abs(a.dv) < std::abs(b.du) + std::abs(b.dv));
   };
   const auto consider = [&](int du, int dv) {
-    if (std::max(std::abs(du), std::abs(dv)) > reach) return;
+    if ((du == 0 && dv == 0) || std::max(std::abs(du), std::abs(dv)) > reach) return;
     const ShiftCount c = CountAtShift(counted, depth, du, dv);
     if (better(c, best)) best = c;
   };
-  for (int du = -reach; du <= reach; du += coarse) {
-    for (int dv = -reach; dv <= reach; dv += coarse) consider(du, dv);
+  int step = std::max(1, (reach + 3) / 4);
+  const int cells = (reach + step - 1) / step;
+  for (int i = -cells; i <= cells; ++i) {
+    for (int k = -cells; k <= cells; ++k) consider(std::clamp(i * step, -reach, reach), std::clamp(k * step, -reach, reach));
   }
-  const int cu = best.du, cv = best.dv;
-  for (int du = cu - coarse + 1; du < cu + coarse && coarse > 1; ++du) {
-    for (int dv = cv - coarse + 1; dv < cv + coarse; ++dv) consider(du, dv);
+  // Compass search: at each step, move to the best of the 8 neighbours until
+  // none is better (at most R moves), then halve the step.
+  while (step > 1) {
+    step = (step + 1) / 2;
+    for (int moves = 0; moves <= reach; ++moves) {
+      const int cu = best.du, cv = best.dv;
+      for (int du = -step; du <= step; du += step) {
+        for (int dv = -step; dv <= step; dv += step) consider(cu + du, cv + dv);
+      }
+      if (best.du == cu && best.dv == cv) break;
+    }
   }
   result.measured = best.measured;
   result.violations = best.violations;
