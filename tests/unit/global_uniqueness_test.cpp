@@ -379,6 +379,20 @@ TEST_CASE("soundness with the frame: no certificate beyond the bound from any st
   CHECK(turned_refused >= 8);    // wrong fits were offered and refused
 }
 
+TEST_CASE("free space: lying intrinsics (focal 1e15 px) neither overflow the pixel reach nor crash") {
+  const ObjectModel object = BumpedBox();
+  Frame frame = RenderFrame(object);
+  frame.view.camera.fx = frame.view.camera.fy = 1e15;
+  const FreeSpaceTest test(object, frame.view, FreeSpaceOptions{}, object.spec().eps_oc);
+  const FreeSpace result = test.Check(frame.truth);
+  CHECK(result.checked);
+  // The optical axis passes through the box, so at this focal length it
+  // covers the whole image: the search runs, with its reach at the image size
+  // (f·τ/z would be ~1e13 px).
+  REQUIRE(result.silhouette > 0);
+  CHECK(result.reach == std::max(frame.view.depth->width, frame.view.depth->height));
+}
+
 TEST_CASE("global uniqueness: the rival slack has a floor in points (few discriminating points on a small cloud)") {
   const ObjectModel object = BumpedBox();
   const Pose truth = TestPose();

@@ -46,6 +46,13 @@ struct ShiftCount {
   int measured = 0, violations = 0;
 };
 
+// Pixels spanned by `length` metres at depth z (focal f in pixels), at most
+// `limit` (the image's size: lying intrinsics cannot overflow the count).
+int PixelsAcross(double focal, double length, double z, int limit) {
+  const double pixels = std::ceil(focal * length / std::max(z, 1e-3));
+  return pixels < limit ? static_cast<int>(pixels) : limit;
+}
+
 // The pixels of the rendered silhouette at least `border` pixels inside it
 // (all samples at `border` covered), each with its violation limit (samples
 // within r that are covered; an uncovered one is the silhouette's edge, which
@@ -64,9 +71,9 @@ std::vector<CountedPixel> CountedPixels(const DepthRenderer& renderer, int w, in
       for (int dv = -border; dv <= border && interior; dv += std::max(border, 1)) interior = covered(u + du, v + dv);
     }
     if (!interior) continue;
-    const int r = border + static_cast<int>(std::ceil(focal * tolerance / std::max(z, 1e-3)));
+    const int r = border + PixelsAcross(focal, tolerance, z, std::max(w, h));
     double farthest = z;
-    for (const int step : {r, (r + 1) / 2}) {
+    for (const int step : {std::max(r, 1), std::max((r + 1) / 2, 1)}) {
       for (int du = -step; du <= step; du += step) {
         for (int dv = -step; dv <= step; dv += step) {
           if (covered(u + du, v + dv)) farthest = std::max(farthest, renderer.DepthAt(u + du, v + dv));
@@ -116,7 +123,7 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   // passed when SOME shift of the whole silhouette within R explains the
   // frame. Search: a grid of step g = ⌈R/4⌉ over [-R, R]² (0 included), then
   // a compass search around the best with steps halving down to one pixel.
-  const int reach = static_cast<int>(std::ceil(focal * tolerance_ / std::max(nearest, 1e-3)));
+  const int reach = PixelsAcross(focal, tolerance_, nearest, std::max(depth.width, depth.height));
   ShiftCount best = CountAtShift(counted, depth, 0, 0);
   // Ties go to the smaller shift (the evidence then says how far the pose is off, not where a tie fell).
   const auto better = [&](const ShiftCount& a, const ShiftCount& b) {
