@@ -314,21 +314,25 @@ TEST_CASE("free space: the whole silhouette shifts together (a pose within the t
 
 namespace {
 
-// The object's points as the frame's camera sees them (every covered pixel
-// back-projected, 1 mm noise per coordinate), optionally without the bump.
+// The object's points as the frame's camera sees them (DepthRenderer's
+// partial cloud: 3000 pixels, 1 mm noise along the ray), optionally without
+// the bump.
 PointSet FrameCloud(const ObjectModel& object, const Pose& truth, bool keep_bump, Rng& rng) {
   CameraIntrinsics camera;
   DepthRenderer renderer(camera);
   renderer.Render(object.mesh(), truth);
+  DepthSampleOptions sample;
+  sample.points = 3000;
+  sample.noise_sigma = 0.001;
+  const PointSet seen = renderer.SampleCloud(sample, rng);
+  if (keep_bump) return seen;
   const Pose model_from_scene = truth.Inverse();
-  PointSet cloud(3, static_cast<Eigen::Index>(renderer.covered_pixels().size()));
+  PointSet kept(3, seen.cols());
   Eigen::Index n = 0;
-  for (const int pixel : renderer.covered_pixels()) {
-    const Eigen::Vector3d p = renderer.BackProject(pixel);
-    if (!keep_bump && (model_from_scene * p).z() > 0.031) continue;   // above the box's top face: the bump
-    cloud.col(n++) = p + 0.001 * Eigen::Vector3d(rng.Normal(), rng.Normal(), rng.Normal());
+  for (Eigen::Index j = 0; j < seen.cols(); ++j) {
+    if ((model_from_scene * Eigen::Vector3d(seen.col(j))).z() <= 0.031) kept.col(n++) = seen.col(j);   // above: the bump
   }
-  return StridedColumns(cloud.leftCols(n), 3000);
+  return kept.leftCols(n);
 }
 
 }  // namespace
