@@ -227,6 +227,10 @@ void AddSegmentOptions(CLI::App& command, SegmentOptions* options) {
                      "Drop pixels whose depth differs from a neighbour's by more than this fraction of their "
                      "depth (0 = off)")
       ->capture_default_str();
+  command.add_option("--support-plane", options->support_plane_distance,
+                     "Drop mask points within this distance (m) of the background's dominant plane (the table "
+                     "masks bleed onto; 0 = off)")
+      ->capture_default_str();
   command.add_option("--max-points", options->max_points,
                      "At most this many points per image segment, evenly strided (0 = all)")
       ->capture_default_str();

@@ -280,13 +280,15 @@ TEST_CASE("certify --bop: ids in every line, certified poses correct, BOP CSV re
   std::map<std::pair<int, int>, json> by_image;
   for (const json& line : lines) {
     for (const char* key : {"scene_id", "im_id", "gt_id", "obj_id", "pixels", "no_depth", "removed_erosion",
-                            "removed_discontinuity", "removed_subsampling", "points", "gt_R", "gt_t"}) {
+                            "removed_discontinuity", "removed_plane", "removed_subsampling", "points", "gt_R",
+                            "gt_t"}) {
       CHECK_MESSAGE(line.contains(key), key);
     }
     CHECK(line["obj_id"] == 1);
     CHECK(line["gt_id"] == 0);
     CHECK(line["pixels"].get<int>() == line["no_depth"].get<int>() + line["removed_erosion"].get<int>() +
-                                           line["removed_discontinuity"].get<int>() + line["removed_subsampling"].get<int>() +
+                                           line["removed_discontinuity"].get<int>() + line["removed_plane"].get<int>() +
+                                           line["removed_subsampling"].get<int>() +
                                            line["points"].get<int>());
     const c3po::Pose truth = split.poses[line["scene_id"].get<int>()][line["im_id"].get<std::size_t>() - 1];
     const c3po::Pose estimate{MatrixOf(line["R"]), Eigen::Vector3d(line["t"][0], line["t"][1], line["t"][2])};

@@ -16,6 +16,7 @@
 #include "c3po/io/rle.hpp"
 #include "c3po/io/segment.hpp"
 #include "c3po/io/shard.hpp"
+#include "c3po/io/support_plane.hpp"
 #include "test_helpers.hpp"
 
 namespace {
@@ -41,6 +42,7 @@ c3po::SegmentOptions NoPreprocessing() {
   c3po::SegmentOptions options;
   options.erode_mask = 0;
   options.max_relative_depth_step = 0.0;
+  options.support_plane_distance = 0.0;
   options.max_points = 0;
   return options;
 }
@@ -204,9 +206,11 @@ TEST_CASE("preprocessing: counts add up, the discontinuity filter equals brute f
       c3po::SegmentOptions options;
       options.erode_mask = erode;
       options.max_relative_depth_step = step;
+      options.support_plane_distance = 0.0;   // the support plane has its own test
       options.max_points = 0;
       const c3po::SegmentCloud s = c3po::ExtractSegment(depth, mask, kCamera, options, "x");
       CHECK(s.mask_pixels == mask.Count());
+      CHECK(s.removed_by_plane == 0);
       CHECK(s.mask_pixels == s.no_depth + s.removed_by_erosion + s.removed_by_discontinuity + s.removed_by_subsampling +
                                  static_cast<std::size_t>(s.cloud.cols()));
       // Brute force over the eroded mask's pixels with depth.
@@ -245,6 +249,175 @@ TEST_CASE("preprocessing: counts add up, the discontinuity filter equals brute f
   CHECK(few.removed_by_subsampling == static_cast<std::size_t>(all.cloud.cols() - 50));
   CHECK(few.cloud == c3po::StridedColumns(all.cloud, 50));
   for (Eigen::Index j = 0; j < 50; ++j) CHECK(few.pixels[static_cast<std::size_t>(j)] == all.pixels[static_cast<std::size_t>(j * all.cloud.cols() / 50)]);
+}
+
+namespace {
+
+// Ray direction of pixel (u, v) with unit z: the point at depth z is z * ray.
+Eigen::Vector3d Ray(const c3po::PinholeCamera& K, int u, int v) { return {(u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0}; }
+
+// A table n.X = c (n unit, tilted towards the camera) with a ball of radius r
+// resting on it; the ball's mask is dilated by `bleed` pixels onto the table.
+struct TableScene {
+  Eigen::Vector3d n = Eigen::Vector3d(0.0, -0.6, -0.8).normalized();   // table normal, towards the camera
+  double c = -0.8;                                                    // n.X = c: 0.8 m from the camera
+  double r = 0.06;
+  Eigen::Vector3d ball;                                               // ball centre
+  DepthImage depth;
+  Mask ball_mask, mask;                                               // visible ball; dilated
+};
+
+TableScene MakeTableScene(int w, int h, int bleed) {
+  TableScene s;
+  const Eigen::Vector3d foot = Eigen::Vector3d::UnitZ() * (s.c / s.n.z());   // the table on the optical axis
+  s.ball = foot + s.r * s.n;
+  s.depth = DepthImage{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
+  s.ball_mask = Mask{w, h, std::vector<std::uint8_t>(s.depth.z.size(), 0)};
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const double table = s.c / s.n.dot(Ray(kCamera, u, v));
+      const double ball = SphereDepth(kCamera, u, v, s.ball, s.r);
+      const bool on_ball = ball > 0.0 && ball < table;
+      s.depth.z[static_cast<std::size_t>(v) * w + u] = static_cast<float>(on_ball ? ball : table);
+      s.ball_mask.inside[static_cast<std::size_t>(v) * w + u] = on_ball;
+    }
+  }
+  // Dilation = complement of the eroded complement.
+  Mask outside = s.ball_mask;
+  for (auto& m : outside.inside) m = !m;
+  s.mask = c3po::ErodeMask(outside, bleed);
+  for (auto& m : s.mask.inside) m = !m;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("support plane: the table under a ball is found, the mask's bleed onto it is dropped, the ball is kept") {
+  const int w = 320, h = 240;
+  const TableScene scene = MakeTableScene(w, h, 6);
+  const double distance = 0.01;
+  REQUIRE(scene.mask.Count() > scene.ball_mask.Count() + 500);
+  const std::optional<c3po::SupportPlaneFit> fit = c3po::FitSupportPlane(scene.depth, scene.mask, kCamera, distance);
+  REQUIRE(fit.has_value());
+  // The analytic table (float depth: micrometre agreement).
+  CHECK(std::abs(std::abs(fit->plane.normal.dot(scene.n)) - 1.0) < 1e-6);
+  for (int v = 0; v < h; v += 37) {
+    for (int u = 0; u < w; u += 41) {
+      if (scene.mask.at(u, v)) continue;
+      CHECK(fit->plane.Distance(kCamera.BackProject(u, v, scene.depth.at(u, v))) < 1e-5);
+    }
+  }
+  CHECK(fit->inlier_samples == fit->background_samples);   // every background sample is table
+  // Same frame, same plane.
+  const std::optional<c3po::SupportPlaneFit> again = c3po::FitSupportPlane(scene.depth, scene.mask, kCamera, distance);
+  CHECK(again->plane.normal == fit->plane.normal);
+  CHECK(again->plane.offset == fit->plane.offset);
+
+  c3po::SegmentOptions options = NoPreprocessing();
+  options.support_plane_distance = distance;
+  const c3po::SegmentCloud segment = c3po::ExtractSegment(scene.depth, scene.mask, kCamera, options, "x");
+  CHECK(segment.support_plane_found);
+  CHECK(segment.mask_pixels == segment.no_depth + segment.removed_by_erosion + segment.removed_by_discontinuity +
+                                   segment.removed_by_plane + segment.removed_by_subsampling +
+                                   static_cast<std::size_t>(segment.cloud.cols()));
+  // Brute force against the analytic table: a mask pixel is kept exactly when
+  // its point is farther than `distance` from the table (a 1e-5 m guard band
+  // for the fitted plane's rounding; no pixel falls inside it here).
+  std::vector<std::int32_t> expected;
+  std::size_t bleed = 0, ball_points_near_table = 0;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      if (!scene.mask.at(u, v)) continue;
+      const Eigen::Vector3d p = kCamera.BackProject(u, v, scene.depth.at(u, v));
+      const double height = std::abs(scene.n.dot(p) - scene.c);
+      REQUIRE(std::abs(height - distance) > 1e-5);
+      if (height > distance) expected.push_back(v * w + u);
+      if (!scene.ball_mask.at(u, v)) ++bleed;
+      if (scene.ball_mask.at(u, v) && height <= distance) ++ball_points_near_table;
+    }
+  }
+  CHECK(segment.pixels == expected);
+  // Every bleeding pixel went; of the ball only the band within `distance` of
+  // the table (its points there are within 1 cm of where it touches).
+  CHECK(segment.removed_by_plane == bleed + ball_points_near_table);
+  CHECK(ball_points_near_table < scene.ball_mask.Count() / 10);
+  CHECK(segment.cloud.cols() + static_cast<Eigen::Index>(ball_points_near_table) ==
+        static_cast<Eigen::Index>(scene.ball_mask.Count()));
+
+  // Off: nothing is dropped.
+  const c3po::SegmentCloud kept_all = c3po::ExtractSegment(scene.depth, scene.mask, kCamera, NoPreprocessing(), "x");
+  CHECK(kept_all.removed_by_plane == 0);
+  CHECK(kept_all.cloud.cols() == static_cast<Eigen::Index>(scene.mask.Count()));
+}
+
+TEST_CASE("support plane: the object's own large face is not the support; no dominant plane, nothing dropped") {
+  const int w = 320, h = 240;
+  const double distance = 0.01;
+  // A frontal box face at 0.6 m covering 56 % of the image, in front of the
+  // tilted table: the mask is the face, the plane must be the table's (the
+  // face would win were the mask's pixels not excluded).
+  TableScene scene = MakeTableScene(w, h, 0);
+  Mask face{w, h, std::vector<std::uint8_t>(scene.depth.z.size(), 0)};
+  for (int v = h / 8; v < 7 * h / 8; ++v) {
+    for (int u = w / 8; u < 7 * w / 8; ++u) {
+      scene.depth.z[static_cast<std::size_t>(v) * w + u] = 0.6f;
+      face.inside[static_cast<std::size_t>(v) * w + u] = 1;
+    }
+  }
+  const std::optional<c3po::SupportPlaneFit> fit = c3po::FitSupportPlane(scene.depth, face, kCamera, distance);
+  REQUIRE(fit.has_value());
+  CHECK(std::abs(std::abs(fit->plane.normal.dot(scene.n)) - 1.0) < 1e-3);   // the ball is background here
+  c3po::SegmentOptions options = NoPreprocessing();
+  options.support_plane_distance = distance;
+  const c3po::SegmentCloud segment = c3po::ExtractSegment(scene.depth, face, kCamera, options, "face");
+  CHECK(segment.removed_by_plane == 0);
+  CHECK(segment.cloud.cols() == static_cast<Eigen::Index>(face.Count()));
+
+  // Corrugated background (amplitude 10 cm, wavelength 10 cm): no plane holds
+  // a fifth of it, so nothing is dropped.
+  DepthImage wavy{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const double x = Ray(kCamera, u, v).x();   // ~ metres at z = 1
+      wavy.z[static_cast<std::size_t>(v) * w + u] = static_cast<float>(1.0 + 0.1 * std::sin(2.0 * M_PI * x / 0.1));
+    }
+  }
+  Mask centre{w, h, std::vector<std::uint8_t>(wavy.z.size(), 0)};
+  for (int v = h / 4; v < 3 * h / 4; ++v) {
+    for (int u = w / 4; u < 3 * w / 4; ++u) centre.inside[static_cast<std::size_t>(v) * w + u] = 1;
+  }
+  CHECK_FALSE(c3po::FitSupportPlane(wavy, centre, kCamera, distance).has_value());
+  const c3po::SegmentCloud on_wavy = c3po::ExtractSegment(wavy, centre, kCamera, options, "wavy");
+  CHECK_FALSE(on_wavy.support_plane_found);
+  CHECK(on_wavy.removed_by_plane == 0);
+
+  // The only background is another object's face (a frontal square at 0.9 m,
+  // a tenth of the image; no depth elsewhere), the target a ball beside it
+  // whose points lie within 1 cm of that face's plane: the face is no
+  // support, nothing is dropped (as on synth --format bop scenes).
+  DepthImage objects{w, h, std::vector<float>(static_cast<std::size_t>(w) * h, 0.0f)};
+  Mask target{w, h, std::vector<std::uint8_t>(objects.z.size(), 0)};
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      if (u < w / 3 && v > h / 3 && v < 2 * h / 3) objects.z[i] = 0.9f;
+      const double ball = SphereDepth(kCamera, u, v, Eigen::Vector3d(0.05, 0.0, 0.9), 0.04);
+      if (ball > 0.0) objects.z[i] = static_cast<float>(ball), target.inside[i] = 1;
+    }
+  }
+  REQUIRE(target.Count() > 100);
+  CHECK_FALSE(c3po::FitSupportPlane(objects, target, kCamera, distance).has_value());
+  const c3po::SegmentCloud beside = c3po::ExtractSegment(objects, target, kCamera, options, "beside");
+  CHECK(beside.removed_by_plane == 0);
+  CHECK(beside.cloud.cols() == static_cast<Eigen::Index>(target.Count()));
+
+  // Lying inputs: NaN and huge depths, an all-mask frame: no plane, no crash.
+  DepthImage lying = scene.depth;
+  for (std::size_t i = 0; i < lying.z.size(); i += 3) lying.z[i] = i % 2 ? std::nanf("") : 1e29f;
+  (void)c3po::FitSupportPlane(lying, face, kCamera, distance);
+  CHECK_FALSE(c3po::FitSupportPlane(scene.depth, FullMask(w, h), kCamera, distance).has_value());
+  options.support_plane_distance = -1.0;
+  CHECK_THROWS_AS(options.Check(), std::invalid_argument);
 }
 
 TEST_CASE("unusable segments: no pixels, no depth, too few points left") {

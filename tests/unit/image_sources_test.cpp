@@ -28,8 +28,9 @@ SegmentCloud SegmentOf(const PointSet& cloud) {
   s.no_depth = 7;
   s.removed_by_erosion = 5;
   s.removed_by_discontinuity = 3;
+  s.removed_by_plane = 4;
   s.removed_by_subsampling = 2;
-  s.mask_pixels = s.pixels.size() + 17;
+  s.mask_pixels = s.pixels.size() + 21;
   return s;
 }
 
@@ -84,7 +85,7 @@ TEST_CASE("segment sources: CertifyBatch equals EstimateAndCertify; counts and i
     CHECK(line.at("obj_id") == 5);
     CHECK(line.at("pixels").get<std::size_t>() ==
           line.at("no_depth").get<std::size_t>() + line.at("removed_erosion").get<std::size_t>() +
-              line.at("removed_discontinuity").get<std::size_t>() +
+              line.at("removed_discontinuity").get<std::size_t>() + line.at("removed_plane").get<std::size_t>() +
               line.at("removed_subsampling").get<std::size_t>() + line.at("points").get<std::size_t>());
     CHECK(line.at("gt_t")[2].get<double>() == poses[i].t(2));
     if (i == 3) {

@@ -58,7 +58,8 @@ SegmentBenchmarkResult BenchmarkSegments(const SegmentBenchmarkOptions& options)
   SegmentBenchmarkResult result;
   const std::size_t variants = options.variants.size();
   // Per variant, per instance: fractions and counts.
-  std::vector<std::vector<double>> over5(variants), over10(variants), points(variants), eroded(variants), edges(variants);
+  std::vector<std::vector<double>> over5(variants), over10(variants), points(variants), eroded(variants), edges(variants),
+      planes(variants);
   for (int obj_id : obj_ids) {
     BopOptions bop;
     bop.obj_id = obj_id;
@@ -73,6 +74,7 @@ SegmentBenchmarkResult BenchmarkSegments(const SegmentBenchmarkOptions& options)
       SegmentOptions all;
       all.erode_mask = 0;
       all.max_relative_depth_step = 0.0;
+      all.support_plane_distance = 0.0;
       all.max_points = 0;
       const SegmentCloud every = LoadBopInstance(instance, all);
       if (every.cloud.cols() == 0) continue;
@@ -99,6 +101,7 @@ SegmentBenchmarkResult BenchmarkSegments(const SegmentBenchmarkOptions& options)
         points[k].push_back(n);
         eroded[k].push_back(static_cast<double>(kept.removed_by_erosion));
         edges[k].push_back(static_cast<double>(kept.removed_by_discontinuity));
+        planes[k].push_back(static_cast<double>(kept.removed_by_plane));
       }
     }
   }
@@ -116,6 +119,7 @@ SegmentBenchmarkResult BenchmarkSegments(const SegmentBenchmarkOptions& options)
       row.instances_at_most_2pc_over_5mm = std::count_if(over5[k].begin(), over5[k].end(), [](double f) { return f <= 0.02; }) / count;
       row.mean_removed_by_erosion = mean(eroded[k]);
       row.mean_removed_by_discontinuity = mean(edges[k]);
+      row.mean_removed_by_plane = mean(planes[k]);
     }
     result.rows.push_back(row);
   }

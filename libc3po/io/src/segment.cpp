@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "c3po/base/error.hpp"
+#include "c3po/io/support_plane.hpp"
 
 namespace c3po {
 
@@ -57,6 +58,9 @@ void SegmentOptions::Check() const {
     throw std::invalid_argument("max_relative_depth_step must be >= 0");
   }
   if (max_points < 0) throw std::invalid_argument("max_points must be >= 0");
+  if (!(support_plane_distance >= 0.0) || !std::isfinite(support_plane_distance)) {
+    throw std::invalid_argument("support_plane_distance must be >= 0");
+  }
 }
 
 namespace {
@@ -89,6 +93,11 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
   result.depth = std::make_shared<const DepthImage>(depth);
   result.camera = camera;
   const Mask eroded = ErodeMask(mask, options.erode_mask);
+  std::optional<SupportPlaneFit> support;
+  if (options.support_plane_distance > 0.0) {
+    support = FitSupportPlane(depth, mask, camera, options.support_plane_distance);
+  }
+  result.support_plane_found = support.has_value();
   std::vector<Eigen::Vector3d> kept;
   std::vector<std::int32_t> kept_pixels;
   for (int v = 0; v < mask.height; ++v) {
@@ -103,8 +112,11 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
       } else if (options.max_relative_depth_step > 0.0 &&
                  OnDepthDiscontinuity(depth, u, v, options.max_relative_depth_step)) {
         ++result.removed_by_discontinuity;
+      } else if (const Eigen::Vector3d point = camera.BackProject(u, v, z);
+                 support && support->plane.Distance(point) <= options.support_plane_distance) {
+        ++result.removed_by_plane;
       } else {
-        kept.push_back(camera.BackProject(u, v, z));
+        kept.push_back(point);
         kept_pixels.push_back(v * mask.width + u);
       }
     }
@@ -133,7 +145,8 @@ void RequireUsableSegment(const SegmentCloud& segment, const std::string& name) 
   throw InputError(name, "only " + std::to_string(segment.cloud.cols()) + " points left after preprocessing (" +
                              std::to_string(segment.mask_pixels) + " mask pixels, " + std::to_string(segment.no_depth) +
                              " without depth, " + std::to_string(segment.removed_by_erosion) + " eroded, " +
-                             std::to_string(segment.removed_by_discontinuity) + " on depth edges)");
+                             std::to_string(segment.removed_by_discontinuity) + " on depth edges, " +
+                             std::to_string(segment.removed_by_plane) + " on the support plane)");
 }
 
 SegmentCloud LoadFrameSegment(const FrameInput& frame, const SegmentOptions& options) {

@@ -34,6 +34,7 @@ struct SegmentBenchmarkRow {
   double instances_at_most_2pc_over_5mm = 0.0;
   double mean_removed_by_erosion = 0.0;
   double mean_removed_by_discontinuity = 0.0;
+  double mean_removed_by_plane = 0.0;
 };
 
 struct SegmentBenchmarkResult {

@@ -8,10 +8,13 @@
 //  3. depth-discontinuity filter: a pixel is dropped when an 8-neighbour with
 //     depth differs from it by more than `max_relative_depth_step` x its depth
 //     ("flying pixels" interpolated across depth edges);
-//  4. a bounded point count: evenly strided pixels (StridedColumns order).
+//  4. support plane: a point within `support_plane_distance` of the
+//     background's dominant plane (the table; support_plane.hpp) is dropped
+//     (masks bleed onto the table around an object's base);
+//  5. a bounded point count: evenly strided pixels (StridedColumns order).
 // Every step's removed count is reported: mask_pixels = no_depth +
-// removed_by_erosion + removed_by_discontinuity + removed_by_subsampling +
-// cloud.cols().
+// removed_by_erosion + removed_by_discontinuity + removed_by_plane +
+// removed_by_subsampling + cloud.cols().
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -41,6 +44,7 @@ Mask ErodeMask(const Mask& mask, int k);
 struct SegmentOptions {
   int erode_mask = 4;                      // pixels; 0 = off
   double max_relative_depth_step = 0.02;   // 0 = filter off
+  double support_plane_distance = 0.01;    // metres; 0 = off
   int max_points = 5000;                   // 0 = every point
   void Check() const;                      // throws std::invalid_argument
 };
@@ -52,6 +56,8 @@ struct SegmentCloud {
   std::size_t no_depth = 0;                // mask pixels without a measurement
   std::size_t removed_by_erosion = 0;      // with depth, removed by step 2
   std::size_t removed_by_discontinuity = 0;
+  std::size_t removed_by_plane = 0;        // step 4
+  bool support_plane_found = false;
   std::size_t removed_by_subsampling = 0;
   // The frame it came from (the free-space test renders the posed model into
   // it, method/free_space.hpp); shared, released by the batch after use.
