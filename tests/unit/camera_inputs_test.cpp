@@ -344,6 +344,17 @@ TEST_CASE("support plane: the table under a ball is found, the mask's bleed onto
   CHECK(segment.cloud.cols() + static_cast<Eigen::Index>(ball_points_near_table) ==
         static_cast<Eigen::Index>(scene.ball_mask.Count()));
 
+  CHECK_NOTHROW(c3po::RequireUsableSegment(segment, "ball"));
+  // A mask that is mostly table (the ball's mask dilated by 40 px) is refused
+  // as input, naming the mask; with the plane off it is a segment as before.
+  const TableScene wide = MakeTableScene(w, h, 40);
+  const c3po::SegmentCloud mostly_table = c3po::ExtractSegment(wide.depth, wide.mask, kCamera, options, "wide.png");
+  REQUIRE(mostly_table.removed_by_plane > (wide.mask.Count() - mostly_table.no_depth) / 2);
+  const std::string error = ErrorOf([&] { c3po::RequireUsableSegment(mostly_table, "wide.png"); });
+  CHECK(error.find("wide.png: the mask is mostly the support plane") == 0);
+  CHECK_NOTHROW(c3po::RequireUsableSegment(
+      c3po::ExtractSegment(wide.depth, wide.mask, kCamera, NoPreprocessing(), "wide.png"), "wide.png"));
+
   // Off: nothing is dropped.
   const c3po::SegmentCloud kept_all = c3po::ExtractSegment(scene.depth, scene.mask, kCamera, NoPreprocessing(), "x");
   CHECK(kept_all.removed_by_plane == 0);

@@ -137,6 +137,13 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
 namespace c3po {
 
 void RequireUsableSegment(const SegmentCloud& segment, const std::string& name) {
+  const std::size_t with_depth = segment.mask_pixels - segment.no_depth;
+  if (segment.removed_by_plane > 0 &&
+      static_cast<double>(segment.removed_by_plane) > kMaxSupportPlaneFraction * static_cast<double>(with_depth)) {
+    throw InputError(name, "the mask is mostly the support plane (" + std::to_string(segment.removed_by_plane) + " of " +
+                               std::to_string(with_depth) +
+                               " pixels with depth lie on the table's plane): it does not outline an object");
+  }
   if (segment.cloud.cols() >= kMinSegmentPoints) return;
   if (segment.mask_pixels == 0) throw InputError(name, "mask has no pixels");
   if (segment.no_depth == segment.mask_pixels) {

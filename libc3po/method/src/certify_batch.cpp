@@ -138,11 +138,9 @@ PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>*
   }
   segment.depth.reset();        // the counts never keep the image alive (~1 MB per instance)
   if (segment_counts != nullptr) *segment_counts = segment;
-  if (cloud.cols() < kMinSegmentPoints) {
-    segment.cloud = cloud;
-    RequireUsableSegment(segment, source.name);   // throws the reason
-  }
-  return cloud;
+  segment.cloud = std::move(cloud);
+  RequireUsableSegment(segment, source.name);   // throws the reason (the counts are already out)
+  return std::move(segment.cloud);
 }
 
 void CertifyBatchOptions::Check() const {

@@ -73,9 +73,16 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
 
 // Fewer points than this is not a segment to estimate a pose from.
 inline constexpr int kMinSegmentPoints = 3;
+// A mask with more than this fraction of its pixels with depth on the support
+// plane outlines the table, not an object: real YCB-Video masks reach 10 %
+// (the marker lying flat), a hand-made patch of table that also covers a
+// corner of another object 90 % (whose remainder, a cropped box, fits a
+// smaller box: docs/camera_inputs.md).
+inline constexpr double kMaxSupportPlaneFraction = 0.5;
 // Throws InputError("name: mask has no pixels" / "no valid depth under the
 // mask (N pixels)" / "only K points left after preprocessing (...)") when the
-// segment has fewer than kMinSegmentPoints points.
+// segment has fewer than kMinSegmentPoints points, and ("name: the mask is
+// mostly the support plane (...)") beyond kMaxSupportPlaneFraction.
 void RequireUsableSegment(const SegmentCloud& segment, const std::string& name);
 
 // One frame given by files: depth (16-bit PNG or .npy), mask PNG (non-zero,
