@@ -253,7 +253,7 @@ int Run(const EvalCommand& cmd) {
     if (instances.empty()) throw InputError("--shard " + cmd.shard, empty_part);
     data_dir = scratch.path() + "/dataset";
     const BopDatasetSummary summary = WriteDatasetFromBop(instances, object.keypoints(), cmd.segment, data_dir);
-    frames = BopDatasetFrames(listed_shared, instances);
+    frames = BopDatasetFrames(listed_shared, instances, cmd.segment);
     for (const std::string& reason : summary.skipped) std::cerr << "c3po eval: skipped " << reason << "\n";
     std::cerr << "c3po eval: " << summary.written << " BOP instances of obj_id " << cmd.bop.options.obj_id << " ("
               << summary.skipped.size() << " skipped)\n";

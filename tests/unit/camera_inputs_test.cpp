@@ -316,7 +316,7 @@ TEST_CASE("support plane: the table under a ball is found, the mask's bleed onto
   c3po::SegmentOptions options = NoPreprocessing();
   options.support_plane_distance = distance;
   const c3po::SegmentCloud segment = c3po::ExtractSegment(scene.depth, scene.mask, kCamera, options, "x");
-  CHECK(segment.support_plane_found);
+  CHECK(segment.support_plane.has_value());
   CHECK(segment.mask_pixels == segment.no_depth + segment.removed_by_erosion + segment.removed_by_discontinuity +
                                    segment.removed_by_plane + segment.removed_by_subsampling +
                                    static_cast<std::size_t>(segment.cloud.cols()));
@@ -399,7 +399,7 @@ TEST_CASE("support plane: the object's own large face is not the support; no dom
   }
   CHECK_FALSE(c3po::FitSupportPlane(wavy, centre, kCamera, distance).has_value());
   const c3po::SegmentCloud on_wavy = c3po::ExtractSegment(wavy, centre, kCamera, options, "wavy");
-  CHECK_FALSE(on_wavy.support_plane_found);
+  CHECK_FALSE(on_wavy.support_plane.has_value());
   CHECK(on_wavy.removed_by_plane == 0);
 
   // The only background is another object's face (a frontal square at 0.9 m,

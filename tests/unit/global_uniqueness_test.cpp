@@ -10,6 +10,8 @@
 
 #include "c3po/base/random.hpp"
 #include "c3po/geometry/render.hpp"
+#include "c3po/geometry/scene_render.hpp"
+#include "c3po/io/support_plane.hpp"
 #include "c3po/method/free_space.hpp"
 #include "c3po/method/global_uniqueness.hpp"
 #include "c3po/method/pipeline.hpp"
@@ -395,6 +397,93 @@ TEST_CASE("free space: lying intrinsics (focal 1e15 px) neither overflow the pix
   // (f·τ/z would be ~1e13 px).
   REQUIRE(result.silhouette > 0);
   CHECK(result.reach == std::max(frame.view.depth->width, frame.view.depth->height));
+}
+
+TEST_CASE("support: a box resting on the table passes, sunk into it fails (counts between brute-force bounds), raised passes") {
+  // An 11 x 9 x 3.5 cm box lying on a table seen obliquely at ~0.8 m; the
+  // frame and the box's mask come from the scene renderer, the support plane
+  // from the segmenter's fit (io/support_plane.hpp).
+  const ObjectModel box = PlainBox({0.11, 0.09, 0.035});
+  Plane table;
+  table.normal = Eigen::Vector3d(0.0, -0.6, -0.8).normalized();   // towards the camera
+  table.offset = table.normal.dot(Eigen::Vector3d(0.0, 0.0, 0.8));
+  Pose truth;
+  truth.R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), table.normal).toRotationMatrix() *
+            Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  truth.t = Eigen::Vector3d(0.0, 0.0, 0.8) + 0.0175 * table.normal;   // the bottom face on the table
+  CameraIntrinsics camera;
+  DepthRenderer renderer(camera);
+  const SceneImage scene = RenderScene(renderer, {{&box.mesh(), truth}}, table);
+  auto depth = std::make_shared<DepthImage>();
+  depth->width = camera.width;
+  depth->height = camera.height;
+  Mask mask{camera.width, camera.height, std::vector<std::uint8_t>(scene.depth.size(), 0)};
+  for (std::size_t i = 0; i < scene.depth.size(); ++i) {
+    depth->z.push_back(static_cast<float>(scene.depth[i]));
+    mask.inside[i] = scene.label[i] == 0;
+  }
+  const double distance = 0.01;
+  const std::optional<SupportPlaneFit> fit = FitSupportPlane(*depth, mask, camera, distance);
+  REQUIRE(fit.has_value());
+  CHECK(fit->plane.normal.dot(table.normal) > 1.0 - 1e-6);   // oriented towards the camera
+  CHECK(std::abs(fit->plane.offset - table.offset) < 1e-5);
+  DepthView view{depth, camera, fit->plane, distance};
+  const FreeSpaceOptions options;
+  const FreeSpaceTest test(box, view, options, box.spec().eps_oc);
+
+  const FreeSpace at_truth = test.Check(truth);
+  REQUIRE(at_truth.support_checked);
+  CHECK(at_truth.passed);
+  CHECK(at_truth.through_support == 0);
+  CHECK(at_truth.support_points == box.sample().cols());
+
+  // Sunk 3 cm into the table. Oracles: every counted point is more than
+  // tau + D below the true table (upper bound, no visibility), and every such
+  // point whose pixel the renderer labels table is counted (lower bound).
+  const double margin = at_truth.tolerance + distance;
+  Pose sunk = truth;
+  sunk.t -= 0.03 * table.normal;
+  int below = 0, below_on_table = 0;
+  for (Eigen::Index j = 0; j < box.sample().cols(); ++j) {
+    const Eigen::Vector3d x = sunk.R * box.sample().col(j) + sunk.t;
+    if (!(table.normal.dot(x) - table.offset < -margin)) continue;
+    ++below;
+    const Eigen::Vector2d uv = view.camera.Project(x);
+    const long u = std::lround(uv.x()), v = std::lround(uv.y());
+    if (u >= 0 && v >= 0 && u < camera.width && v < camera.height &&
+        scene.label[static_cast<std::size_t>(v) * camera.width + u] == SceneImage::kBackground) {
+      ++below_on_table;
+    }
+  }
+  const FreeSpace through = test.Check(sunk);
+  CHECK(through.through_support >= below_on_table);
+  CHECK(through.through_support <= below);
+  CHECK(below_on_table > options.max_fraction * box.sample().cols());
+  CHECK_FALSE(through.passed);
+  CHECK_FALSE(test.Passes(sunk, nullptr));   // a rival sunk into the table is no rival
+
+  // Raised 3 cm: floating is not the support test's business (none through).
+  Pose raised = truth;
+  raised.t += 0.03 * table.normal;
+  CHECK(test.Check(raised).through_support == 0);
+
+  // Without the plane, nothing is claimed about the table.
+  DepthView no_plane{depth, camera};
+  const FreeSpaceTest without(box, no_plane, options, box.spec().eps_oc);
+  const FreeSpace unchecked = without.Check(sunk);
+  CHECK_FALSE(unchecked.support_checked);
+  CHECK(unchecked.through_support == 0);
+
+  // Where the table is not seen (no depth under the sunk box's image), no
+  // point counts: only a seen table is known to be solid.
+  auto blind = std::make_shared<DepthImage>(*depth);
+  for (Eigen::Index j = 0; j < box.sample().cols(); ++j) {
+    const Eigen::Vector2d uv = view.camera.Project(sunk.R * box.sample().col(j) + sunk.t);
+    const long u = std::lround(uv.x()), v = std::lround(uv.y());
+    if (u >= 0 && v >= 0 && u < camera.width && v < camera.height) blind->z[static_cast<std::size_t>(v) * camera.width + u] = 0.0f;
+  }
+  const FreeSpaceTest blind_test(box, DepthView{blind, camera, fit->plane, distance}, options, box.spec().eps_oc);
+  CHECK(blind_test.Check(sunk).through_support == 0);
 }
 
 TEST_CASE("global uniqueness: the rival slack has a floor in points (few discriminating points on a small cloud)") {

@@ -97,7 +97,10 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
   if (options.support_plane_distance > 0.0) {
     support = FitSupportPlane(depth, mask, camera, options.support_plane_distance);
   }
-  result.support_plane_found = support.has_value();
+  if (support) {
+    result.support_plane = support->plane;
+    result.support_plane_distance = options.support_plane_distance;
+  }
   std::vector<Eigen::Vector3d> kept;
   std::vector<std::int32_t> kept_pixels;
   for (int v = 0; v < mask.height; ++v) {

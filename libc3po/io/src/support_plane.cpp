@@ -67,7 +67,7 @@ std::optional<PlaneWithResidual> FitPlane(const std::vector<Eigen::Vector3d>& po
   if (!(values(1) > 4.0 * std::max(values(0), 0.0))) return std::nullopt;
   PlaneWithResidual fit;
   fit.plane.normal = eigen.eigenvectors().col(0).normalized();
-  fit.plane.offset = -fit.plane.normal.dot(mean);
+  fit.plane.offset = fit.plane.normal.dot(mean);
   fit.rms = std::sqrt(std::max(values(0), 0.0));
   return fit;
 }
@@ -129,6 +129,8 @@ std::optional<SupportPlaneFit> FitSupportPlane(const DepthImage& depth, const Ma
     const int count = CountWithin(grid.points, refit->plane, distance);
     if (count >= best_count) result.plane = refit->plane, result.inlier_samples = count;
   }
+  // The camera's side is positive: Signed(camera centre) = -offset > 0.
+  if (result.plane.offset > 0.0) result.plane.normal = -result.plane.normal, result.plane.offset = -result.plane.offset;
   result.image_samples = grid.columns * grid.rows;
   result.background_samples = static_cast<int>(grid.points.size());
   if (result.inlier_samples < std::max(3.0, min_image_fraction * result.image_samples)) return std::nullopt;

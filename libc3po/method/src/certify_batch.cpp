@@ -135,6 +135,8 @@ PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>*
   if (frame != nullptr) {
     frame->depth = segment.depth;
     frame->camera = segment.camera;
+    frame->support = segment.support_plane;
+    frame->support_distance = segment.support_plane_distance;
   }
   segment.depth.reset();        // the counts never keep the image alive (~1 MB per instance)
   if (segment_counts != nullptr) *segment_counts = segment;

@@ -121,6 +121,7 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["free_space_silhouette"] = f.silhouette;
   line["free_space_tolerance"] = f.tolerance;
   line["free_space_shift_px"] = {f.shift_u, f.shift_v};
+  line["through_support"] = f.support_checked ? nlohmann::ordered_json(f.through_support) : nlohmann::ordered_json(nullptr);
   line["ms"] = e.milliseconds;
 }
 

@@ -103,9 +103,42 @@ ShiftCount CountAtShift(const std::vector<CountedPixel>& counted, const DepthIma
 // Violations beyond the allowed fraction (<= 0 passes): what the shift search minimises.
 double Excess(const ShiftCount& c, double max_fraction) { return c.violations - max_fraction * c.measured; }
 
+// Model sample points more than `margin` beyond the support plane whose
+// pixel sees the plane (observed point within `distance` of it).
+int CountThroughSupport(const PointSet& sample, const Pose& camera_from_model, const DepthImage& depth,
+                        const PinholeCamera& camera, const Plane& plane, double distance, double margin) {
+  int count = 0;
+  for (Eigen::Index j = 0; j < sample.cols(); ++j) {
+    const Eigen::Vector3d x = camera_from_model.R * sample.col(j) + camera_from_model.t;
+    if (!(plane.Signed(x) < -margin) || !(x.z() > 0.0)) continue;
+    const Eigen::Vector2d uv = camera.Project(x);
+    if (!uv.allFinite() || uv.x() < -0.5 || uv.y() < -0.5 || uv.x() >= depth.width - 0.5 || uv.y() >= depth.height - 0.5) {
+      continue;
+    }
+    const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
+    const float observed = depth.at(u, v);
+    if (!DepthImage::Valid(observed)) continue;
+    count += plane.Distance(camera.BackProject(u, v, observed)) <= distance;
+  }
+  return count;
+}
+
 }  // namespace
 
 FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
+  FreeSpace result = CheckSilhouette(camera_from_model);
+  if (!result.checked || !view_.support) return result;
+  // The table is solid where it is seen (free_space.hpp "Support").
+  const PointSet& sample = object_.sample();
+  result.support_checked = true;
+  result.support_points = static_cast<int>(sample.cols());
+  result.through_support = CountThroughSupport(sample, camera_from_model, *view_.depth, view_.camera, *view_.support,
+                                               view_.support_distance, tolerance_ + view_.support_distance);
+  if (result.through_support > options_.max_fraction * result.support_points) result.passed = false;
+  return result;
+}
+
+FreeSpace FreeSpaceTest::CheckSilhouette(const Pose& camera_from_model) const {
   FreeSpace result;
   result.tolerance = tolerance_;
   if (!renderer_ || !options_.enabled) return result;

@@ -71,14 +71,20 @@ std::vector<BopInstance> ShardBopInstances(const std::vector<BopInstance>& insta
   return part;
 }
 
-DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances) {
+DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances,
+                               const SegmentOptions& options) {
   auto by_cloud = std::make_shared<std::map<std::string, BopInstance>>();
   for (const BopInstance& instance : instances) (*by_cloud)[BopDatasetCloudName(instance)] = instance;
-  return [listed, by_cloud](const DatasetEntry& entry) {
+  return [listed, by_cloud, options](const DatasetEntry& entry) {
     const auto it = by_cloud->find(entry.cloud);
     if (it == by_cloud->end()) return DepthView{};
-    // The depth image alone: the segment is the dataset's cloud already.
-    return DepthView{std::make_shared<const DepthImage>(LoadBopDepth(it->second)), it->second.camera.K};
+    // The segment is the dataset's cloud already; the frame and its support
+    // plane come from the same extraction certify --bop makes.
+    const SegmentCloud segment = LoadBopInstance(it->second, options);
+    DepthView view{segment.depth, segment.camera};
+    view.support = segment.support_plane;
+    view.support_distance = segment.support_plane_distance;
+    return view;
   };
 }
 

@@ -12,16 +12,11 @@
 #include <vector>
 
 #include "c3po/geometry/mesh.hpp"
+#include "c3po/geometry/plane.hpp"
 #include "c3po/geometry/render.hpp"
 #include "c3po/base/types.hpp"
 
 namespace c3po {
-
-// The plane {x : normal . x = offset} in the camera frame (normal of unit length).
-struct Plane {
-  Eigen::Vector3d normal = -Eigen::Vector3d::UnitZ();
-  double offset = -1.0;
-};
 
 struct SceneInstance {
   const Mesh* mesh = nullptr;

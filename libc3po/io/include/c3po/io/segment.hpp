@@ -17,10 +17,12 @@
 // removed_by_subsampling + cloud.cols().
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "c3po/geometry/camera.hpp"
+#include "c3po/geometry/plane.hpp"
 #include "c3po/io/camera_io.hpp"
 #include "c3po/io/png_io.hpp"
 #include "c3po/base/types.hpp"
@@ -57,12 +59,14 @@ struct SegmentCloud {
   std::size_t removed_by_erosion = 0;      // with depth, removed by step 2
   std::size_t removed_by_discontinuity = 0;
   std::size_t removed_by_plane = 0;        // step 4
-  bool support_plane_found = false;
   std::size_t removed_by_subsampling = 0;
   // The frame it came from (the free-space test renders the posed model into
   // it, method/free_space.hpp); shared, released by the batch after use.
   std::shared_ptr<const DepthImage> depth;
   PinholeCamera camera;
+  // The frame's support plane (step 4) when one was found, and its distance.
+  std::optional<Plane> support_plane;
+  double support_plane_distance = 0.0;
 };
 
 // Back-projects the mask's pixels. Throws InputError("name: ...") when depth

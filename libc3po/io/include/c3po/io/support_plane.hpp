@@ -25,14 +25,8 @@
 
 namespace c3po {
 
-struct Plane {
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   // unit
-  double offset = 0.0;                                  // normal . x + offset = 0
-  double Distance(const Eigen::Vector3d& x) const { return std::abs(normal.dot(x) + offset); }
-};
-
 struct SupportPlaneFit {
-  Plane plane;
+  Plane plane;                      // oriented: the camera centre is on its positive side (offset < 0)
   int image_samples = 0;            // grid cells of the whole image
   int background_samples = 0;       // of them, background pixels with depth
   int inlier_samples = 0;           // of those, within `distance` of the plane

@@ -28,10 +28,12 @@ std::vector<CloudSource> ShardSources(const std::vector<CloudSource>& sources, c
 // dataset); instances keep pointing into their BopInstances' detections.
 std::vector<BopInstance> ShardBopInstances(const std::vector<BopInstance>& instances, const Shard& shard);
 // The depth frames of a dataset written from BOP instances (WriteDatasetFromBop,
-// eval --bop): an entry's frame is its instance's depth image and camera
-// (LoadBopDepth, read when asked); an entry no instance names has none.
+// eval --bop): an entry's frame is its instance's depth image, camera and
+// support plane (the instance's segment under `options`, extracted when
+// asked); an entry no instance names has none.
 // `listed` keeps the instances' detections alive.
-DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances);
+DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances,
+                               const SegmentOptions& options);
 // BOP results rows (bop.hpp) from a batch: one per BOP source whose
 // registration succeeded; score = CertificateScore with the batch's eps_oc;
 // time = the seconds of all the object's sources of that image.
