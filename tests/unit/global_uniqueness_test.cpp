@@ -216,7 +216,7 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   for (int v = 200; v < 280; ++v) {
     for (int u = 0; u < occluded->width; ++u) occluded->z[static_cast<std::size_t>(v) * occluded->width + u] = 0.5f;
   }
-  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera}, options, object.spec().eps_oc);
+  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera, std::nullopt, 0.0}, options, object.spec().eps_oc);
   const FreeSpace behind_occluder = with_occluder.Check(frame.truth);
   CHECK(behind_occluder.passed);
   CHECK(behind_occluder.violations == 0);
@@ -229,7 +229,7 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   // Missing depth is unknown, not a violation.
   auto holes = std::make_shared<DepthImage>(*frame.view.depth);
   std::fill(holes->z.begin(), holes->z.end(), 0.0f);
-  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera}, options, object.spec().eps_oc);
+  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera, std::nullopt, 0.0}, options, object.spec().eps_oc);
   const FreeSpace unknown = blind.Check(shifted);
   CHECK(unknown.passed);
   CHECK(unknown.measured == 0);
@@ -536,7 +536,7 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
   CHECK(test.Check(raised).through_support == 0);
 
   // Without the plane, nothing is claimed about the table.
-  DepthView no_plane{depth, camera};
+  DepthView no_plane{depth, camera, std::nullopt, 0.0};
   const FreeSpaceTest without(box, no_plane, options, box.spec().eps_oc);
   const FreeSpace unchecked = without.Check(sunk);
   CHECK_FALSE(unchecked.support_checked);

@@ -112,10 +112,9 @@ int CountThroughSupport(const PointSet& sample, const Pose& camera_from_model, c
     const Eigen::Vector3d x = camera_from_model.R * sample.col(j) + camera_from_model.t;
     if (!(plane.Signed(x) < -margin) || !(x.z() > 0.0)) continue;
     const Eigen::Vector2d uv = camera.Project(x);
-    if (!uv.allFinite() || uv.x() < -0.5 || uv.y() < -0.5 || uv.x() >= depth.width - 0.5 || uv.y() >= depth.height - 0.5) {
-      continue;
-    }
+    if (!uv.allFinite() || uv.x() < -1.0 || uv.y() < -1.0 || uv.x() > depth.width || uv.y() > depth.height) continue;
     const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
+    if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) continue;
     const float observed = depth.at(u, v);
     if (!DepthImage::Valid(observed)) continue;
     count += plane.Distance(camera.BackProject(u, v, observed)) <= distance;

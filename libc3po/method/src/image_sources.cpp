@@ -81,10 +81,7 @@ DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const
     // The segment is the dataset's cloud already; the frame and its support
     // plane come from the same extraction certify --bop makes.
     const SegmentCloud segment = LoadBopInstance(it->second, options);
-    DepthView view{segment.depth, segment.camera};
-    view.support = segment.support_plane;
-    view.support_distance = segment.support_plane_distance;
-    return view;
+    return DepthView{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance};
   };
 }
 

@@ -9,8 +9,10 @@
 // plane segmentation before clustering).
 //
 // The plane is fitted to the background (valid depth pixels outside the
-// object's mask) without random sampling: every block of 32 x 32 px whose
-// back-projected samples are flat gives a hypothesis (least-squares plane),
+// object's mask), sampled on a grid of ~20 000 cells, without random
+// sampling: every block of 8 x 8 cells (32 x 32 px on a 640 x 480 image)
+// whose back-projected samples are flat (RMS residual <= distance / 2) gives
+// a hypothesis (least-squares plane),
 // the hypothesis with the most background samples within `distance` wins and
 // is refitted to those inliers. A plane is accepted only when it holds at
 // least `min_image_fraction` of the whole image's samples: a frame without a
