@@ -181,6 +181,7 @@ int Run(SelftrainCommand cmd) {
                options.batch,
                cmd.optimizer.c_str(), cmd.lr);
   ProgressBar progress("selftrain", 1);
+  bool hinted = false;
   const SelfTrainResult result = SelfTrain(
       object, clouds, *detector, options,
       [&](const SelfTrainEpochLog& e) {
@@ -196,6 +197,16 @@ int Run(SelftrainCommand cmd) {
                             std::to_string(e.validation_hausdorff_median) + "]").c_str()
                          : "",
                      e.seconds);
+        if (!hinted && e.ambiguous_surface_q50 >= 0 && 2 * e.ambiguous_skipped >= e.certified_samples) {
+          // Mostly ambiguous: say how far the second basins are from a symmetry.
+          hinted = true;
+          std::fprintf(stderr, "c3po selftrain: %d of %d certified samples were ambiguous; their second basins lie a "
+                       "median %.3g from the chosen pose on the surface (symmetry tolerance %.3g): if the object is "
+                       "symmetric within that, --symmetry-tolerance declares it (docs/method.md, \"Symmetric "
+                       "labellings\")\n",
+                       e.ambiguous_skipped, e.certified_samples, e.ambiguous_surface_q50,
+                       options.pseudo_labels.SymmetryTolerance(options.pipeline.certificate.eps_oc));
+        }
         progress = ProgressBar("selftrain", 1);
       },
       [&](std::size_t done, std::size_t total) { progress.Update(total ? done / total : 0); }, cmd.resume,

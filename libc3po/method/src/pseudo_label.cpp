@@ -66,9 +66,9 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
       ++check.rivals_refuted;   // the frame rules this basin out
       continue;
     }
-    if (options.symmetry_aware && rival.passes_oc &&
-        PosedSurfaceHausdorff(object, queries, estimate.scene_from_model, rival.scene_from_model) <=
-            symmetry_tolerance) {
+    const double surface_distance =
+        PosedSurfaceHausdorff(object, queries, estimate.scene_from_model, rival.scene_from_model);
+    if (options.symmetry_aware && rival.passes_oc && surface_distance <= symmetry_tolerance) {
       // The same shape placed by other keypoints: a symmetric labelling.
       check.symmetric_labellings.push_back(rival.keypoints);
       continue;
@@ -79,6 +79,7 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
       check.rival_passes_oc = rival.passes_oc;
       check.rival_keypoint_distance = rival.keypoint_distance;
       check.rival_axis = rival.axis;
+      check.rival_surface_distance = surface_distance;
     }
     if (rival.passes_oc || residual <= options.residual_ratio * check.residual) {
       check.ambiguous = true;

@@ -186,6 +186,7 @@ json LogJson(const SelfTrainEpochLog& log) {
 #define C3PO_WRITE(field) j[#field] = log.field;
   C3PO_SELFTRAIN_LOG_FIELDS(C3PO_WRITE)
 #undef C3PO_WRITE
+  j["ambiguous_surface_q50"] = log.ambiguous_surface_q50;
   return j;
 }
 
@@ -209,6 +210,8 @@ SelfTrainEpochLog LogFromJson(const json& j, const std::string& where) {
 #define C3PO_READ(field) ReadStateField(j, #field, &log.field, where);
   C3PO_SELFTRAIN_LOG_FIELDS(C3PO_READ)
 #undef C3PO_READ
+  // Added 2026-12-01: checkpoints written before lack it (then -1).
+  if (j.contains("ambiguous_surface_q50")) ReadStateField(j, "ambiguous_surface_q50", &log.ambiguous_surface_q50, where);
   return log;
 }
 
@@ -259,6 +262,7 @@ struct EpochStats {
   int symmetric = 0;   // trained samples with symmetric labellings
   int switched = 0;    // ... whose target was not y* (another labelling was nearer the detection)
   double iterations = 0.0;
+  std::vector<double> ambiguous_surface;   // PseudoLabelCheck::rival_surface_distance of the ambiguous
 };
 
 // One pass over the training clouds: certify each batch with the current
@@ -300,6 +304,7 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
       stats.iterations += estimates[i].correction.iterations;
       stats.certified += FitsObservation(estimates[i]);
       stats.ambiguous += checks[i].ambiguous;
+      if (checks[i].ambiguous) stats.ambiguous_surface.push_back(checks[i].rival_surface_distance);
       if (usable[i]) {
         ++(*pseudo_label_uses)[static_cast<std::size_t>(order[start + i])];
         certified_clouds.push_back(batch[i]);
@@ -455,6 +460,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     log.ambiguous_skipped = stats.ambiguous;
     log.symmetric_trained = stats.symmetric;
     log.labelling_switched = stats.switched;
+    if (!stats.ambiguous_surface.empty()) log.ambiguous_surface_q50 = Quantile(stats.ambiguous_surface, 0.5);
     log.validation_percent_identified = held_out.percent_identified;
     log.validation_ambiguous = held_out.ambiguous;
     log.validation_residual_q50 = held_out.residual_q50;

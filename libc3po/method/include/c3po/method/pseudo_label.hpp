@@ -55,6 +55,11 @@ struct PseudoLabelCheck {
   bool rival_passes_oc = false;
   double rival_keypoint_distance = 0.0;   // max_i ||y*_i - y'_i|| of that rival
   int rival_axis = -1;               // principal axis (0 = largest extent) of the flip
+  // PosedSurfaceHausdorff of T̂·B̂ and that rival's posed model (-1: none):
+  // how far from a symmetry the second basin is. An object whose certified
+  // samples are all ambiguous at a small surface distance may be symmetric
+  // within it (then --symmetry-tolerance declares it).
+  double rival_surface_distance = -1.0;
   int rivals_refuted = 0;            // second basins the cloud's frame refutes (free space)
   // Keypoints of the second basins that pass oc within the symmetry
   // tolerance of the chosen pose (symmetry_aware only): y* and these are the

@@ -52,6 +52,11 @@ struct SelfTrainEpochLog {
   int ambiguous_skipped = 0;          // certified training samples refused as ambiguous
   int symmetric_trained = 0;          // trained samples with symmetric labellings (symmetry-aware loss)
   int labelling_switched = 0;         // ... whose target was a labelling other than y* (nearer the detection)
+  // Median PosedSurfaceHausdorff between the chosen pose and the second basin
+  // of the ambiguous training samples (-1: none ambiguous); with
+  // symmetry_tolerance it tells a near-symmetry (all samples ambiguous a few
+  // mm away) from real ambiguity.
+  double ambiguous_surface_q50 = -1.0;
   // Label-free validation criteria.
   double validation_percent_identified = 0.0;  // oc and not ambiguous
   int validation_ambiguous = 0;
