@@ -138,10 +138,7 @@ ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<
     identified[i] = FitsObservation(e) && !check.ambiguous;
   });
   for (std::size_t i = 0; i < clouds.size(); ++i) {
-    // The fit residual of the clouds the certificate accepts as this object
-    // (oc and free space): in mixed data the other objects' clouds, refused,
-    // would otherwise set the median (75 % of a real mixed split).
-    if (FitsObservation(measured.estimates[i])) {
+    if (measured.estimates[i].ok()) {
       residuals.push_back(FitResidual(object, clouds[i], measured.estimates[i].scene_from_model));
     }
     fit.ambiguous += ambiguous[i];
@@ -341,12 +338,9 @@ namespace {
 // detected keypoints far further from their corrections (the detector's
 // agreement with its own pseudo-labels) than the best epoch's. Better: not
 // worse, and more identified clouds, or as many with better agreement.
-// The residual rule compares two fits only when both accepted some clouds
-// (a quantile of none is 0).
 bool Worse(const ValidationFit& candidate, const ValidationFit& best, double residual_tolerance, double eps_oc) {
-  const bool residuals = candidate.residual_q50 > 0.0 && best.residual_q50 > 0.0;
   return candidate.percent_identified < best.percent_identified ||
-         (residuals && candidate.residual_q50 > best.residual_q50 * (1.0 + residual_tolerance)) ||
+         candidate.residual_q50 > best.residual_q50 * (1.0 + residual_tolerance) ||
          candidate.detection_error > 1.5 * best.detection_error + 0.1 * eps_oc;
 }
 bool Better(const ValidationFit& candidate, const ValidationFit& best, double residual_tolerance, double eps_oc) {
