@@ -58,6 +58,7 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
   PipelineOptions exact = pipeline;
   exact.certificate.global.rival_extra_fraction = 0.0;
   exact.certificate.global.rival_extra_min = 0;
+  Pose reported;   // the reported rival's pose (its surface distance is measured once, below)
   for (const RivalFit& rival : RefineRivals(object, cloud, estimate, exact, frame, half_turns)) {
     if (!rival.ok) continue;
     if (rival.keypoint_distance <= eps_oc) continue;   // the same basin
@@ -66,9 +67,9 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
       ++check.rivals_refuted;   // the frame rules this basin out
       continue;
     }
-    const double surface_distance =
-        PosedSurfaceHausdorff(object, queries, estimate.scene_from_model, rival.scene_from_model);
-    if (options.symmetry_aware && rival.passes_oc && surface_distance <= symmetry_tolerance) {
+    if (options.symmetry_aware && rival.passes_oc &&
+        PosedSurfaceHausdorff(object, queries, estimate.scene_from_model, rival.scene_from_model) <=
+            symmetry_tolerance) {
       // The same shape placed by other keypoints: a symmetric labelling.
       check.symmetric_labellings.push_back(rival.keypoints);
       continue;
@@ -79,11 +80,14 @@ PseudoLabelCheck CheckPseudoLabel(const ObjectModel& object, const PointSet& clo
       check.rival_passes_oc = rival.passes_oc;
       check.rival_keypoint_distance = rival.keypoint_distance;
       check.rival_axis = rival.axis;
-      check.rival_surface_distance = surface_distance;
+      reported = rival.scene_from_model;
     }
     if (rival.passes_oc || residual <= options.residual_ratio * check.residual) {
       check.ambiguous = true;
     }
+  }
+  if (check.ambiguous) {
+    check.rival_surface_distance = PosedSurfaceHausdorff(object, queries, estimate.scene_from_model, reported);
   }
   return check;
 }

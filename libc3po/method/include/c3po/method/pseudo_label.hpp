@@ -55,7 +55,8 @@ struct PseudoLabelCheck {
   bool rival_passes_oc = false;
   double rival_keypoint_distance = 0.0;   // max_i ||y*_i - y'_i|| of that rival
   int rival_axis = -1;               // principal axis (0 = largest extent) of the flip
-  // PosedSurfaceHausdorff of T̂·B̂ and that rival's posed model (-1: none):
+  // PosedSurfaceHausdorff of T̂·B̂ and that rival's posed model, measured
+  // when the sample is ambiguous (-1 otherwise):
   // how far from a symmetry the second basin is. An object whose certified
   // samples are all ambiguous at a small surface distance may be symmetric
   // within it (then --symmetry-tolerance declares it).
