@@ -646,4 +646,60 @@ TEST_CASE("mixed unlabelled data: another object's clouds are never pseudo-label
     });
     CHECK(is_own);
   }
+  // The label-free epoch criterion measures the fit residual of the clouds
+  // the certificate accepts: the cube's refused clouds do not move it.
+  // Oracle: the same detector measured on the object's clouds alone.
+  const ValidationFit on_mixed =
+      MeasureValidationFit(object, mixed, detector, options.pipeline, options.pseudo_labels, nullptr, {}, nullptr);
+  const ValidationFit on_own =
+      MeasureValidationFit(object, own, detector, options.pipeline, options.pseudo_labels, nullptr, {}, nullptr);
+  REQUIRE(on_own.percent_oc > 0.0);
+  CHECK(on_mixed.percent_oc == doctest::Approx(on_own.percent_oc / 2.0));
+  CHECK(on_mixed.residual_q50 == on_own.residual_q50);
+  CHECK(on_mixed.residual_q90 == on_own.residual_q90);
+}
+
+TEST_CASE("epoch criterion: the validation measures the detector, not re-estimation's rescue") {
+  // A 2.5 cm bump: a detector in the flipped basin is refuted by the bump's
+  // points, and re-estimation's half-turn restart would certify the truth
+  // whatever the detector said. Selection must see the detector as it is.
+  const ObjectModel object = FlatNearSymmetricObject(0.025);
+  const auto clouds = NoisyClouds(object, 8, 0.0005, 9);
+  SelfTrainOptions options = Options(object);
+  OffsetDetector flipped(TurnedKeypoints(object, 180.0), 0.0);
+  PipelineOptions rescued = options.pipeline;
+  rescued.certificate.global.reestimate = true;
+  // Oracles: the detector + corrector alone, and the same with re-estimation.
+  const CertifiedFraction alone = MeasureCertified(object, clouds, flipped, options.pipeline);
+  const CertifiedFraction with_restarts = MeasureCertified(object, clouds, flipped, rescued);
+  REQUIRE(alone.percent_oc == 0.0);
+  REQUIRE(with_restarts.percent_oc == 100.0);
+  const ValidationFit fit =
+      MeasureValidationFit(object, clouds, flipped, rescued, options.pseudo_labels, nullptr, {}, nullptr);
+  CHECK(fit.percent_oc == alone.percent_oc);
+  CHECK(fit.percent_identified == 0.0);
+  // No cloud is accepted, so no residual is measured (and none is compared).
+  CHECK(fit.residual_q50 == 0.0);
+}
+
+TEST_CASE("epoch selection: a detector that starts with no oc validation cloud can improve") {
+  // The detector starts in the flipped basin (no validation cloud passes oc,
+  // so the start has no residual and no agreement to compare); re-estimation
+  // makes its training pseudo-labels. An epoch that identifies validation
+  // clouds is better, never "worse" than a start that measured nothing.
+  const ObjectModel object = FlatNearSymmetricObject(0.025);
+  const auto clouds = NoisyClouds(object, 16, 0.0005, 10);
+  SelfTrainOptions options = Options(object);
+  options.epochs = 6;
+  options.batch = 4;
+  options.pipeline.certificate.global.reestimate = true;
+  OffsetDetector detector(TurnedKeypoints(object, 180.0), 0.5);
+  const SelfTrainResult result = SelfTrain(object, clouds, detector, options);
+  REQUIRE(result.initial.percent_oc == 0.0);
+  CHECK(result.best_epoch > 0);
+  CHECK(result.best.percent_identified == 100.0);
+  // Oracle: the kept detector + corrector, without re-estimation, on every cloud.
+  PipelineOptions as_used = options.pipeline;
+  as_used.certificate.global.reestimate = false;
+  CHECK(MeasureCertified(object, clouds, detector, as_used).percent_oc == 100.0);
 }

@@ -119,7 +119,13 @@ ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<
                                    const std::vector<Pose>& symmetries, const std::vector<DepthView>* frames) {
   ValidationFit fit;
   if (clouds.empty()) return fit;
-  const CertifiedFraction measured = MeasureCertified(object, clouds, detector, pipeline, false, frames);
+  // The detector is validated as it is used: without the re-estimation's
+  // restarts (GlobalUniquenessOptions::reestimate), which would rescue a
+  // refuted estimate whatever the detector said and hide its regressions
+  // (method.md "Self-training: epoch selection"). Training still uses them.
+  PipelineOptions as_detected = pipeline;
+  as_detected.certificate.global.reestimate = false;
+  const CertifiedFraction measured = MeasureCertified(object, clouds, detector, as_detected, false, frames);
   fit.percent_oc = measured.percent_oc;
   fit.percent_certified = measured.percent_certified;
   fit.detection_error = measured.detection_error;
@@ -133,12 +139,15 @@ ValidationFit MeasureValidationFit(const ObjectModel& object, const std::vector<
     options.check_ambiguity = pseudo_labels.check_ambiguity && FitsObservation(e);
     const std::optional<FreeSpaceTest> free_space = FrameTest(object, frames, i, pipeline);
     const PseudoLabelCheck check =
-        CheckPseudoLabel(object, clouds[i], e, pipeline, options, frame, free_space ? &*free_space : nullptr);
+        CheckPseudoLabel(object, clouds[i], e, as_detected, options, frame, free_space ? &*free_space : nullptr);
     ambiguous[i] = check.ambiguous;
     identified[i] = FitsObservation(e) && !check.ambiguous;
   });
   for (std::size_t i = 0; i < clouds.size(); ++i) {
-    if (measured.estimates[i].ok()) {
+    // The fit residual of the clouds the certificate accepts as this object
+    // (oc and free space): in mixed data the other objects' clouds, refused,
+    // would otherwise set the median (75 % of a real mixed split).
+    if (FitsObservation(measured.estimates[i])) {
       residuals.push_back(FitResidual(object, clouds[i], measured.estimates[i].scene_from_model));
     }
     fit.ambiguous += ambiguous[i];
@@ -338,10 +347,15 @@ namespace {
 // detected keypoints far further from their corrections (the detector's
 // agreement with its own pseudo-labels) than the best epoch's. Better: not
 // worse, and more identified clouds, or as many with better agreement.
+// The residual and agreement rules compare two fits only when both accepted
+// some clouds (a quantile of none, an RMS over none, is 0: a detector that
+// starts with no oc validation cloud must not make every later one worse).
 bool Worse(const ValidationFit& candidate, const ValidationFit& best, double residual_tolerance, double eps_oc) {
+  const bool residuals = candidate.residual_q50 > 0.0 && best.residual_q50 > 0.0;
+  const bool agreement = candidate.percent_oc > 0.0 && best.percent_oc > 0.0;
   return candidate.percent_identified < best.percent_identified ||
-         candidate.residual_q50 > best.residual_q50 * (1.0 + residual_tolerance) ||
-         candidate.detection_error > 1.5 * best.detection_error + 0.1 * eps_oc;
+         (residuals && candidate.residual_q50 > best.residual_q50 * (1.0 + residual_tolerance)) ||
+         (agreement && candidate.detection_error > 1.5 * best.detection_error + 0.1 * eps_oc);
 }
 bool Better(const ValidationFit& candidate, const ValidationFit& best, double residual_tolerance, double eps_oc) {
   if (Worse(candidate, best, residual_tolerance, eps_oc)) return false;

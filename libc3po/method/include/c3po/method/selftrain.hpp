@@ -60,7 +60,7 @@ struct SelfTrainEpochLog {
   // Label-free validation criteria.
   double validation_percent_identified = 0.0;  // oc and not ambiguous
   int validation_ambiguous = 0;
-  double validation_residual_q50 = 0.0;        // RMS fit residual quantiles over the validation clouds
+  double validation_residual_q50 = 0.0;        // RMS fit residual quantiles over the validation clouds that fit the observation (oc, free space)
   double validation_residual_q90 = 0.0;
   bool rolled_back = false;                    // worse than the best: the best weights were restored
   // Reporting only, when ground truth was given (never used for selection);
