@@ -290,9 +290,11 @@ class RecordingDetector : public OffsetDetector {
   using OffsetDetector::OffsetDetector;
   double TrainStep(const std::vector<PointSet>& clouds, const std::vector<PointSet>& targets) override {
     trained.insert(trained.end(), clouds.begin(), clouds.end());
+    step_sizes.push_back(clouds.size());
     return OffsetDetector::TrainStep(clouds, targets);
   }
   std::vector<PointSet> trained;
+  std::vector<std::size_t> step_sizes;
 };
 
 // Adds `damage` to every offset after its sabotage_step-th training step.
@@ -634,8 +636,18 @@ TEST_CASE("mixed unlabelled data: another object's clouds are never pseudo-label
   RecordingDetector detector(CentredKeypoints(object).colwise() + Eigen::Vector3d(0.02, 0.0, 0.01), 0.5);
   SelfTrainOptions options = Options(object);
   options.epochs = 3;
-  SelfTrain(object, mixed, detector, options);
+  const SelfTrainResult result = SelfTrain(object, mixed, detector, options);
   REQUIRE_FALSE(detector.trained.empty());
+  // Steps count pseudo-labels, not clouds: every step but the last of an
+  // epoch is a full batch, although half the clouds are refused (with one
+  // step per batch of clouds the steps would hold ~4 of 8).
+  std::size_t short_steps = 0;
+  for (const std::size_t size : detector.step_sizes) {
+    CHECK(size <= static_cast<std::size_t>(options.batch));
+    short_steps += size < static_cast<std::size_t>(options.batch);
+  }
+  CHECK(short_steps <= result.epochs.size());
+  CHECK(detector.step_sizes.size() > result.epochs.size());
   // And the final detector + corrector certifies none of the cube's clouds.
   const CertifiedFraction on_other = MeasureCertified(object, std::vector<PointSet>(mixed.begin() + 24, mixed.end()),
                                                       detector, options.pipeline);

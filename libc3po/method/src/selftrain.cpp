@@ -274,8 +274,24 @@ struct EpochStats {
   std::vector<double> ambiguous_surface;   // PseudoLabelCheck::rival_surface_distance of the ambiguous
 };
 
-// One pass over the training clouds: certify each batch with the current
-// detector, then one regression step on its observably correct samples.
+// One regression step on the first `count` pending pseudo-labels.
+void StepOnPending(TrainableDetector& detector, std::size_t count, std::vector<PointSet>* clouds,
+                   std::vector<PointSet>* targets, EpochStats* stats) {
+  const std::vector<PointSet> step_clouds(clouds->begin(), clouds->begin() + static_cast<long>(count));
+  const std::vector<PointSet> step_targets(targets->begin(), targets->begin() + static_cast<long>(count));
+  clouds->erase(clouds->begin(), clouds->begin() + static_cast<long>(count));
+  targets->erase(targets->begin(), targets->begin() + static_cast<long>(count));
+  stats->loss_sum += detector.TrainStep(step_clouds, step_targets);
+  ++stats->steps;
+}
+
+// One pass over the training clouds: certify each batch of clouds with the
+// current detector and collect the usable pseudo-labels; a regression step
+// is taken on every `batch` of pseudo-labels (the remainder at the end of
+// the epoch). Steps count pseudo-labels, not clouds: in mixed data the other
+// objects' refused clouds do not turn one step into several smaller ones
+// (measured on the real mixed run: 4 steps of ~7 samples per epoch instead
+// of the object alone's one step of ~29).
 EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clouds,
                     const std::vector<int>& order, TrainableDetector& detector,
                     const SelfTrainOptions& options, const ProgressCallback& progress,
@@ -283,6 +299,8 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
                     std::vector<int>* pseudo_label_uses, const std::vector<DepthView>* frames) {
   EpochStats stats;
   const PrincipalFrame frame = ModelPrincipalFrame(object);
+  const auto batch_size = static_cast<std::size_t>(options.batch);
+  std::vector<PointSet> pending_clouds, pending_targets;
   for (std::size_t start = 0; start < order.size(); start += options.batch) {
     HoldForInterruptAt(epoch, static_cast<long long>(start / options.batch));
     ThrowIfInterrupted();
@@ -308,7 +326,6 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
                                    free_space ? &*free_space : nullptr);
       usable[i] = !checks[i].ambiguous;
     });
-    std::vector<PointSet> certified_clouds, targets;
     for (std::size_t i = 0; i < batch.size(); ++i) {
       stats.iterations += estimates[i].correction.iterations;
       stats.certified += FitsObservation(estimates[i]);
@@ -316,21 +333,23 @@ EpochStats RunEpoch(const ObjectModel& object, const std::vector<PointSet>& clou
       if (checks[i].ambiguous) stats.ambiguous_surface.push_back(checks[i].rival_surface_distance);
       if (usable[i]) {
         ++(*pseudo_label_uses)[static_cast<std::size_t>(order[start + i])];
-        certified_clouds.push_back(batch[i]);
+        pending_clouds.push_back(batch[i]);
         // Pseudo-label: the corrected keypoints, or the symmetric labelling nearest the detection.
         const PointSet& target = NearestLabelling(estimates[i].detected_keypoints, estimates[i].keypoints,
                                                   checks[i].symmetric_labellings);
         stats.symmetric += !checks[i].symmetric_labellings.empty();
         stats.switched += &target != &estimates[i].keypoints;
-        targets.push_back(target);
+        pending_targets.push_back(target);
       }
     }
     stats.seen += static_cast<int>(batch.size());
-    if (!certified_clouds.empty()) {
-      stats.loss_sum += detector.TrainStep(certified_clouds, targets);
-      ++stats.steps;
+    while (pending_clouds.size() >= batch_size) {
+      StepOnPending(detector, batch_size, &pending_clouds, &pending_targets, &stats);
     }
     if (progress) progress(progress_offset + end, progress_total);
+  }
+  if (!pending_clouds.empty()) {
+    StepOnPending(detector, pending_clouds.size(), &pending_clouds, &pending_targets, &stats);
   }
   return stats;
 }
