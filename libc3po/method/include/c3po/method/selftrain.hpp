@@ -22,7 +22,7 @@ namespace c3po {
 
 struct SelfTrainOptions {
   int epochs = 20;
-  int batch = 32;
+  int batch = 32;                     // clouds certified together, and pseudo-labels per regression step
   double validation_fraction = 0.1;   // held-out part of the unlabelled clouds
   double stop_at_percent_oc = 99.0;   // early stop on validation % identified (oc and unambiguous)
   // Label-free epoch selection (method.md "Self-training"): an epoch is
