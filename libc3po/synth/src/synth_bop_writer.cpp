@@ -16,6 +16,7 @@
 #include "c3po/base/version.hpp"
 #include "c3po/io/png_io.hpp"
 #include "c3po/synth/synth_bop.hpp"
+#include "run_batch.hpp"
 
 namespace c3po {
 namespace {
@@ -103,24 +104,6 @@ ImageRecord RecordOf(const SynthBopImage& image, const BopSynthOptions& options)
   record.target_visible_pixels = image.instances.front().px_count_visib;
   record.instances = image.instances.size();
   return record;
-}
-
-// Runs images [begin, end) on `renderers.size()` workers, worker w taking
-// begin + w, begin + w + W, ... (each image has its own random stream).
-template <typename Consume>
-void RunBatch(const BopSceneGenerator& generator, std::size_t begin, std::size_t end,
-              std::vector<std::unique_ptr<DepthRenderer>>& renderers, Consume consume) {
-  const int workers = static_cast<int>(renderers.size());
-  ParallelFor(
-      0, workers,
-      [&](int w) {
-        for (std::size_t i = begin + static_cast<std::size_t>(w); i < end;
-             i += static_cast<std::size_t>(workers)) {
-          if (InterruptRequested()) return;
-          consume(i, generator.Generate(i, renderers[static_cast<std::size_t>(w)].get()));
-        }
-      },
-      workers);
 }
 
 // One image per line, as bop_toolkit writes its scene files.

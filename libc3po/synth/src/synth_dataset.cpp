@@ -12,6 +12,7 @@
 #include "c3po/io/dataset.hpp"
 #include "c3po/io/dataset_writer.hpp"
 #include "c3po/synth/synth.hpp"
+#include "run_batch.hpp"
 
 namespace c3po {
 namespace {
@@ -58,25 +59,6 @@ DatasetEntry EntryOf(const SynthSample& sample, std::size_t index, const std::op
   entry.detected_keypoints = sample.detected_keypoints;
   entry.visible = sample.visible;
   return entry;
-}
-
-// Runs generator items [begin, end) on `renderers.size()` workers, worker w
-// taking items begin + w, begin + w + W, ... (each item has its own random
-// stream, so the result does not depend on the schedule).
-template <typename Consume>
-void RunBatch(const SynthGenerator& generator, std::size_t begin, std::size_t end,
-              std::vector<std::unique_ptr<DepthRenderer>>& renderers, Consume consume) {
-  const int workers = static_cast<int>(renderers.size());
-  ParallelFor(
-      0, workers,
-      [&](int w) {
-        for (std::size_t i = begin + static_cast<std::size_t>(w); i < end;
-             i += static_cast<std::size_t>(workers)) {
-          if (InterruptRequested()) return;
-          consume(i, generator.Generate(i, renderers[static_cast<std::size_t>(w)].get()));
-        }
-      },
-      workers);
 }
 
 std::vector<std::unique_ptr<DepthRenderer>> MakeRenderers(const SynthGenerator& generator,
