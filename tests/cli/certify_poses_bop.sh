@@ -5,7 +5,8 @@
 # instances of the object per image (a CSV row has no gt_id: it is tried on
 # both, and each instance keeps its best certified row). Rows of another
 # obj_id are skipped with a note; rows of an image that is not there are
-# unmatched (exit 2).
+# unmatched (exit 2). Each line carries its instance's ids, segment counts and
+# ground truth (gt_hausdorff of the certified pose) as certify --bop lines do.
 # Usage: certify_poses_bop.sh C3PO_BIN SOURCE_DIR WORK_DIR
 set -euo pipefail
 C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
@@ -60,6 +61,10 @@ for a in first:
     dr = max(abs(x - y) for ra, rb in zip(a["R"], b["R"]) for x, y in zip(ra, rb))
     dt = max(abs(x - y) for x, y in zip(a["t"], b["t"]))
     assert dr < 1e-7 and dt < 1e-6, (a["cloud"], dr, dt)
+    # The lines carry the BOP instance's keys and ground truth as certify --bop writes them.
+    for key in ("scene_id", "im_id", "gt_id", "obj_id", "points", "gt_t"):
+        assert b[key] == a[key], (key, b[key], a[key])
+    assert abs(b["gt_hausdorff"] - a["gt_hausdorff"]) < 1e-5, (b["gt_hausdorff"], a["gt_hausdorff"])
 print("instances", len(first), "certified", sum(certified_first.values()), "hypotheses", len(again))
 PY
 
