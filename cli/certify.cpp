@@ -160,6 +160,13 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
                  << "\n";
     }
   }
+  if (!cmd.bop_csv_path.empty()) {
+    std::vector<std::size_t> written;   // one row per instance: its chosen (else best-fitting) hypothesis
+    for (const auto& v : verdicts) {
+      if (v.best_fit) written.push_back(*v.best_fit);
+    }
+    WriteFileAtomically(cmd.bop_csv_path, BopCsv(BopResultRows(matched.sources, result, written)));
+  }
   if (!cmd.output_path.empty()) {
     WriteFileAtomically(cmd.output_path, json_lines.str());
   } else if (cmd.json) {
@@ -186,9 +193,6 @@ int Run(const CertifyCommand& cmd) {
   const std::size_t detectors = cmd.detector.models.size() + cmd.detector.detectors.size();
   if (!cmd.poses_path.empty() && detectors != 0) {
     throw InputError("--poses replaces the detector: give no --model / --detector with it");
-  }
-  if (!cmd.poses_path.empty() && !cmd.bop_csv_path.empty()) {
-    throw InputError("--bop-csv is not written with --poses (use -o for the JSON lines)");
   }
   if (cmd.poses_path.empty() && detectors != 1) {
     throw InputError("give exactly one of --model FILE, --detector NAME or --poses FILE");
@@ -298,7 +302,8 @@ RunFunction SetupCertify(CLI::App& command) {
   AddBopOptions(command, &cmd->bop, BopDetections::kAllowed);
   AddSegmentOptions(command, &cmd->segment);
   command.add_option("--bop-csv", cmd->bop_csv_path,
-                     "Write BOP results CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm)");
+                     "Write BOP results CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm; score: certified first); "
+                     "with --poses one row per instance: its chosen hypothesis, else its best fit");
   AddShardOption(command, &cmd->shard, "clouds (by image for --bop, by cloud or manifest line otherwise)");
   return [cmd]() { return Run(*cmd); };
 }

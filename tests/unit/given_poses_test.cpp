@@ -146,6 +146,26 @@ TEST_CASE("Given poses are certified as they are: only the right one passes, and
     }
   }
 
+  CHECK(verdicts[0].best_fit == verdicts[0].chosen);   // the CSV row of a certified instance is its chosen one
+
+  SUBCASE("without a certified hypothesis the CSV row is the best fit (brute force over the outcomes)") {
+    CertifyBatchResult refused = result;
+    for (CloudOutcome& outcome : refused.outcomes) outcome.estimate.certificate.oc.passed = false;
+    const auto none = ChooseCertified(matched, poses, refused);
+    REQUIRE(none.size() == 1);
+    CHECK_FALSE(none[0].chosen);
+    REQUIRE(none[0].best_fit);
+    std::size_t smallest = 0;
+    for (std::size_t s = 1; s < 3; ++s) {
+      if (refused.outcomes[s].estimate.certificate.oc.max_point_distance <
+          refused.outcomes[smallest].estimate.certificate.oc.max_point_distance) {
+        smallest = s;
+      }
+    }
+    CHECK(*none[0].best_fit == smallest);
+    CHECK(matched.hypothesis[smallest] != 0);   // never the 90°-turned pose
+  }
+
   SUBCASE("with correction the wrong start is reported with its change") {
     options.pipeline.correct = true;
     const CertifyBatchResult corrected = CertifyBatch(object, matched.sources, nullptr, options);

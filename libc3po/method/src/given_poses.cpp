@@ -78,26 +78,41 @@ PoseChange ChangeBetween(const Pose& given, const Pose& estimate) {
 std::vector<InstanceVerdict> ChooseCertified(const GivenPoseSources& matched,
                                              const std::vector<PoseHypothesis>& poses,
                                              const CertifyBatchResult& result) {
+  // s fits better than t: smaller oc distance, then the higher score (file
+  // order keeps the earlier line on a full tie).
+  auto better = [&](std::size_t s, std::size_t t) {
+    const double fit = result.outcomes[s].estimate.certificate.oc.max_point_distance;
+    const double other_fit = result.outcomes[t].estimate.certificate.oc.max_point_distance;
+    return fit < other_fit ||
+           (fit == other_fit && poses[matched.hypothesis[s]].score > poses[matched.hypothesis[t]].score);
+  };
   std::map<std::size_t, InstanceVerdict> verdicts;
+  std::map<std::size_t, std::size_t> best_uncertified;
   for (std::size_t s = 0; s < matched.sources.size(); ++s) {
     InstanceVerdict& verdict = verdicts[matched.instance[s]];
     verdict.instance = matched.instance[s];
     verdict.sources.push_back(s);
     const CloudOutcome& outcome = result.outcomes[s];
-    if (!outcome.certified()) continue;
-    if (!verdict.chosen) {
-      verdict.chosen = s;
-      continue;
+    if (outcome.certified()) {
+      if (!verdict.chosen || better(s, *verdict.chosen)) verdict.chosen = s;
+    } else if (outcome.processed() && outcome.estimate.ok()) {
+      auto found = best_uncertified.find(verdict.instance);
+      if (found == best_uncertified.end()) {
+        best_uncertified[verdict.instance] = s;
+      } else if (better(s, found->second)) {
+        found->second = s;
+      }
     }
-    const CloudOutcome& best = result.outcomes[*verdict.chosen];
-    const double fit = outcome.estimate.certificate.oc.max_point_distance;
-    const double best_fit = best.estimate.certificate.oc.max_point_distance;
-    const double score = poses[matched.hypothesis[s]].score;
-    const double best_score = poses[matched.hypothesis[*verdict.chosen]].score;
-    if (fit < best_fit || (fit == best_fit && score > best_score)) verdict.chosen = s;
   }
   std::vector<InstanceVerdict> out;
-  for (auto& [instance, verdict] : verdicts) out.push_back(std::move(verdict));
+  for (auto& [instance, verdict] : verdicts) {
+    verdict.best_fit = verdict.chosen;
+    if (!verdict.best_fit) {
+      auto found = best_uncertified.find(instance);
+      if (found != best_uncertified.end()) verdict.best_fit = found->second;
+    }
+    out.push_back(std::move(verdict));
+  }
   return out;
 }
 

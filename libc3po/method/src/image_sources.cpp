@@ -86,6 +86,13 @@ DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const
 }
 
 std::vector<BopResultRow> BopResultRows(const std::vector<CloudSource>& sources, const CertifyBatchResult& result) {
+  std::vector<std::size_t> all(sources.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return BopResultRows(sources, result, all);
+}
+
+std::vector<BopResultRow> BopResultRows(const std::vector<CloudSource>& sources, const CertifyBatchResult& result,
+                                        const std::vector<std::size_t>& written) {
   std::map<std::pair<int, int>, double> image_seconds;
   for (std::size_t i = 0; i < sources.size(); ++i) {
     if (sources[i].provenance) {
@@ -93,7 +100,7 @@ std::vector<BopResultRow> BopResultRows(const std::vector<CloudSource>& sources,
     }
   }
   std::vector<BopResultRow> rows;
-  for (std::size_t i = 0; i < sources.size(); ++i) {
+  for (std::size_t i : written) {
     const CloudOutcome& outcome = result.outcomes[i];
     if (!sources[i].provenance || !outcome.processed() || !outcome.estimate.ok()) continue;
     const CloudProvenance& p = *sources[i].provenance;

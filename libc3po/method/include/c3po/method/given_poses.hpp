@@ -59,11 +59,14 @@ PoseChange ChangeBetween(const Pose& given, const Pose& estimate);
 
 // Per instance (cloud source) with at least one hypothesis: the certified
 // hypothesis with the best fit (smallest oc distance, then the higher score,
-// then the earlier line), or none.
+// then the earlier line), or none; and the instance's row of a BOP results
+// CSV: the chosen hypothesis, else the best fit among those the corrector
+// returned a pose for (same order), or none.
 struct InstanceVerdict {
   std::size_t instance = 0;                // index into the cloud sources
   std::vector<std::size_t> sources;        // its hypotheses' indices into GivenPoseSources::sources
   std::optional<std::size_t> chosen;       // index into GivenPoseSources::sources
+  std::optional<std::size_t> best_fit;     // the same; == chosen when there is one
 };
 std::vector<InstanceVerdict> ChooseCertified(const GivenPoseSources& matched,
                                              const std::vector<PoseHypothesis>& poses,

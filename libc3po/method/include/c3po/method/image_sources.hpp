@@ -38,5 +38,10 @@ DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const
 // registration succeeded; score = CertificateScore with the batch's eps_oc;
 // time = the seconds of all the object's sources of that image.
 std::vector<BopResultRow> BopResultRows(const std::vector<CloudSource>& sources, const CertifyBatchResult& result);
+// The same for the sources listed in `written` only (in that order; time
+// still sums every source of the image): certify --poses writes one row per
+// instance, its chosen hypothesis.
+std::vector<BopResultRow> BopResultRows(const std::vector<CloudSource>& sources, const CertifyBatchResult& result,
+                                        const std::vector<std::size_t>& written);
 
 }  // namespace c3po
