@@ -351,7 +351,8 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "rivals_tried",
                                          "rivals_found", "rival_distance", "rival_hausdorff", "rival_outliers",
                                          "rival_axis", "rival_angle_deg", "rival_passes_oc",
-                                         "rival_free_space_violations", "free_space", "free_space_violations",
+                                         "rival_free_space_violations", "rival_R", "rival_t", "free_space",
+                                         "free_space_violations",
                                          "free_space_measured", "free_space_silhouette", "free_space_tolerance",
                                          "free_space_shift_px", "through_support",
                                          "ms"});
@@ -397,6 +398,13 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   } else {
     CHECK(j["nd_global"].is_null());
   }
+  if (nd.global.rival_axis >= 0) {
+    CHECK(j["rival_R"][2][1].get<double>() == nd.global.rival_scene_from_model.R(2, 1));
+    CHECK(j["rival_t"][0].get<double>() == nd.global.rival_scene_from_model.t(0));
+  } else {
+    CHECK(j["rival_R"].is_null());
+    CHECK(j["rival_t"].is_null());
+  }
   CHECK(j["free_space"].is_null());   // a ready-made cloud: no depth frame
   // Outlier indices are capped at kMaxListedOutliers; the count stays exact.
   PoseEstimate many = e;
@@ -431,4 +439,24 @@ TEST_CASE("certify JSON lines: the corrector's robust kernel and its truncation 
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(CertifyJsonLine("a.ply", e));
   CHECK(j["robust_loss"] == "tls");
   CHECK(j["robust_scale"].get<double>() == options.certificate.eps_oc);
+}
+
+TEST_CASE("certify JSON lines: the reported rival's pose, read back exactly (null without one)") {
+  const Fixture f;
+  PoseEstimate e = EstimateAndCertify(f.object, f.clouds[0], f.detected[0], f.Options().pipeline);
+  REQUIRE(e.ok());
+  // A rival as CheckGlobalUniqueness reports it: the estimate turned by a half-turn.
+  Rng rng(5);
+  GlobalUniqueness& g = e.certificate.nd.global;
+  g.rival_axis = 1;
+  g.rival_scene_from_model = Pose{rng.Rotation(), Eigen::Vector3d(0.1, -0.2, 0.9)};
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(CertifyJsonLine("a.ply", e));
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) CHECK(j["rival_R"][r][c].get<double>() == g.rival_scene_from_model.R(r, c));
+    CHECK(j["rival_t"][r].get<double>() == g.rival_scene_from_model.t(r));
+  }
+  g.rival_axis = -1;   // every rival fell back into the estimate's basin: nothing to show
+  const nlohmann::ordered_json none = nlohmann::ordered_json::parse(CertifyJsonLine("a.ply", e));
+  CHECK(none["rival_R"].is_null());
+  CHECK(none["rival_t"].is_null());
 }

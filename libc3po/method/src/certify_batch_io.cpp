@@ -113,6 +113,11 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["rival_angle_deg"] = g.rival_angle_deg;
   line["rival_passes_oc"] = g.rival_passes_oc;
   line["rival_free_space_violations"] = g.rival_free_space_violations;
+  // The reported rival's pose (scene_from_model, like R and t): the second explanation to look at.
+  const Pose& rival = g.rival_scene_from_model;
+  line["rival_R"] = g.rival_axis >= 0 ? RotationJson(rival.R) : nlohmann::ordered_json(nullptr);
+  line["rival_t"] = g.rival_axis >= 0 ? nlohmann::ordered_json({rival.t(0), rival.t(1), rival.t(2)})
+                                      : nlohmann::ordered_json(nullptr);
   // Free space (depth-image inputs, free_space.hpp); null when not checked.
   const FreeSpace& f = e.certificate.free_space;
   line["free_space"] = f.checked ? nlohmann::ordered_json(f.passed) : nlohmann::ordered_json(nullptr);
