@@ -72,7 +72,8 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
 
 // The certify JSON line of a given pose (with the source's keys: a BOP
 // instance's ids, segment counts and ground truth, as `certify --bop` writes
-// them), with the hypothesis and the change the correction made appended (docs/method.md "Certifying poses from any estimator").
+// them), with the hypothesis and the change the correction made appended
+// (docs/method.md "Certifying poses from any estimator").
 std::string GivenPoseJsonLine(const CloudSource& source, const CloudOutcome& outcome,
                               const PoseHypothesis& pose, bool chosen) {
   std::string line = CertifyJsonLine(source, outcome);
@@ -146,7 +147,9 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
       if (cmd.json) json_lines << CertifyErrorJsonLine(name, outcome.error) << "\n";
       continue;
     }
-    if (cmd.json || !cmd.output_path.empty()) json_lines << GivenPoseJsonLine(matched.sources[s], outcome, pose, chosen[s]) << "\n";
+    if (cmd.json || !cmd.output_path.empty()) {
+      json_lines << GivenPoseJsonLine(matched.sources[s], outcome, pose, chosen[s]) << "\n";
+    }
     if (!cmd.json) {
       const PoseChange change = ChangeBetween(pose.scene_from_model, outcome.estimate.scene_from_model);
       std::printf("%s  change %.3g deg, %.4g%s\n", HumanLine(name, outcome).c_str(), change.rotation_degrees,

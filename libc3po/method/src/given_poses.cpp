@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <utility>
@@ -78,11 +79,15 @@ PoseChange ChangeBetween(const Pose& given, const Pose& estimate) {
 std::vector<InstanceVerdict> ChooseCertified(const GivenPoseSources& matched,
                                              const std::vector<PoseHypothesis>& poses,
                                              const CertifyBatchResult& result) {
-  // s fits better than t: smaller oc distance, then the higher score (file
-  // order keeps the earlier line on a full tie).
+  // s fits better than t: smaller oc distance (not finite = worst), then the
+  // higher score (file order keeps the earlier line on a full tie).
+  auto fit_of = [&](std::size_t s) {
+    const double d = result.outcomes[s].estimate.certificate.oc.max_point_distance;
+    return std::isfinite(d) ? d : std::numeric_limits<double>::infinity();
+  };
   auto better = [&](std::size_t s, std::size_t t) {
-    const double fit = result.outcomes[s].estimate.certificate.oc.max_point_distance;
-    const double other_fit = result.outcomes[t].estimate.certificate.oc.max_point_distance;
+    const double fit = fit_of(s);
+    const double other_fit = fit_of(t);
     return fit < other_fit ||
            (fit == other_fit && poses[matched.hypothesis[s]].score > poses[matched.hypothesis[t]].score);
   };
