@@ -92,7 +92,6 @@ std::vector<InstanceVerdict> ChooseCertified(const GivenPoseSources& matched,
            (fit == other_fit && poses[matched.hypothesis[s]].score > poses[matched.hypothesis[t]].score);
   };
   std::map<std::size_t, InstanceVerdict> verdicts;
-  std::map<std::size_t, std::size_t> best_uncertified;
   for (std::size_t s = 0; s < matched.sources.size(); ++s) {
     InstanceVerdict& verdict = verdicts[matched.instance[s]];
     verdict.instance = matched.instance[s];
@@ -101,21 +100,12 @@ std::vector<InstanceVerdict> ChooseCertified(const GivenPoseSources& matched,
     if (outcome.certified()) {
       if (!verdict.chosen || better(s, *verdict.chosen)) verdict.chosen = s;
     } else if (outcome.processed() && outcome.estimate.ok()) {
-      auto found = best_uncertified.find(verdict.instance);
-      if (found == best_uncertified.end()) {
-        best_uncertified[verdict.instance] = s;
-      } else if (better(s, found->second)) {
-        found->second = s;
-      }
+      if (!verdict.best_fit || better(s, *verdict.best_fit)) verdict.best_fit = s;   // best uncertified so far
     }
   }
   std::vector<InstanceVerdict> out;
   for (auto& [instance, verdict] : verdicts) {
-    verdict.best_fit = verdict.chosen;
-    if (!verdict.best_fit) {
-      auto found = best_uncertified.find(instance);
-      if (found != best_uncertified.end()) verdict.best_fit = found->second;
-    }
+    if (verdict.chosen) verdict.best_fit = verdict.chosen;
     out.push_back(std::move(verdict));
   }
   return out;
