@@ -20,6 +20,7 @@
 #include "c3po/method/certify_batch.hpp"
 #include "c3po/method/given_poses.hpp"
 #include "c3po/method/image_sources.hpp"
+#include "c3po/method/refusal.hpp"
 #include "c3po/object/object_io.hpp"
 #include "command.hpp"
 #include "options.hpp"
@@ -67,7 +68,27 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
                 e.certificate.nd.local.min_eigenvalue, e.scene_from_model.t(0), e.scene_from_model.t(1),
                 e.scene_from_model.t(2), rotation.angle() * 180.0 / M_PI, e.correction.iterations,
                 e.milliseconds);
-  return text;
+  if (e.certified()) return text;
+  return std::string(text) + "  refused by " + RefusalSummary(e.certificate);
+}
+
+// "; refused by nd_global 36, oc 10": every failed part counted once per
+// refused pose, in the order the certificate decides them; "" when none was.
+std::string RefusalTally(const CertifyBatchResult& result) {
+  std::vector<int> counts(kCertificatePartCount, 0);
+  int registration = 0;
+  for (const CloudOutcome& outcome : result.outcomes) {
+    if (!outcome.processed() || outcome.estimate.certified()) continue;
+    if (!outcome.estimate.ok()) ++registration;
+    else for (const CertificatePart part : RefusedBy(outcome.estimate.certificate)) ++counts[static_cast<std::size_t>(part)];
+  }
+  std::string tally;
+  const auto add = [&](const char* name, int count) {
+    if (count > 0) tally += (tally.empty() ? "; refused by " : ", ") + std::string(name) + " " + std::to_string(count);
+  };
+  add("registration", registration);
+  for (std::size_t k = 0; k < counts.size(); ++k) add(ToString(static_cast<CertificatePart>(k)), counts[k]);
+  return tally;
 }
 
 // The certify JSON line of a given pose (with the source's keys: a BOP
@@ -274,10 +295,10 @@ int Run(const CertifyCommand& cmd) {
   }
   if (!cmd.json) {
     std::printf("certified %d/%zu (oc %d, nd %d, errors %d); eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g); "
-                "%s\n",
+                "%s%s\n",
                 result.certified, sources.size(), result.oc, result.nd, result.errors, result.certificate.eps_oc,
                 result.certificate.delta_nd, object.diameter(),
-                DescribeRobust(result.certificate, options.pipeline.corrector).c_str());
+                DescribeRobust(result.certificate, options.pipeline.corrector).c_str(), RefusalTally(result).c_str());
   }
   if (result.errors > 0) return 2;
   return result.certified == static_cast<int>(sources.size()) ? 0 : 1;

@@ -3,7 +3,8 @@
 // Checks: loads without console errors or network requests; the results
 // table has EXPECTED_ROWS rows; the soundness section and the SVG plots are
 // there; the 3D view has a WebGL canvas that draws points (non-background
-// pixels), a mouse drag orbits the camera and the example buttons switch views.
+// pixels), a mouse drag orbits the camera, the example buttons switch views
+// and every rejected example names why it was refused.
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
 
@@ -79,6 +80,16 @@ try {
     await buttons.nth(state.views - 1).click();
     check(await page.evaluate(() => window.c3poReport.shown) === state.views - 1, 'clicking a button shows its example');
     check((await page.locator('#view-info').textContent()).includes('ADD-S'), 'example info shows its ADD-S');
+  }
+
+  // Every rejected example says why (the failed certificate parts), a certified one does not.
+  check(await page.locator('#layer-rival').count() === 1, 'a layer for the rival pose that refused an example');
+  for (let i = 0; i < state.views; ++i) {
+    await page.evaluate(k => window.c3poReport.show(k), i);
+    const info = await page.locator('#view-info').textContent();
+    const certified = info.startsWith('CERTIFIED');
+    check(info.includes('refused by ') === !certified,
+          `example ${i} (${certified ? 'certified' : 'rejected'}) ${certified ? 'has no' : 'names its'} refusal`);
   }
 
   check(errors.length === 0, 'no console errors' + (errors.length ? ': ' + errors.join(' | ') : ''));

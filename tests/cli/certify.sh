@@ -16,7 +16,7 @@ set +e
 status=$?
 set -e
 [ "$(wc -l < good.jsonl)" -eq 6 ] || fail "expected 6 JSON lines, got $(wc -l < good.jsonl)"
-for field in '"cloud"' '"R"' '"t"' '"keypoints"' '"oc"' '"nd"' '"certified"' '"oc_distance"' \
+for field in '"cloud"' '"R"' '"t"' '"keypoints"' '"oc"' '"nd"' '"certified"' '"refused_by"' '"oc_distance"' \
              '"eps_oc"' '"delta_nd"' '"iterations"' '"ms"'; do
   grep -q "$field" good.jsonl || fail "field $field missing"
 done
@@ -30,6 +30,20 @@ else [ $status -eq 1 ] || fail "$certified/6 certified but exit $status"; fi
 set +e; "$C3PO" certify "$OBJ" --detector manifest --data bad --no-correct > bad.txt 2>&1; status=$?; set -e
 [ $status -eq 1 ] || fail "hopeless keypoints: expected exit 1, got $status"
 grep -q "certified 0/3" bad.txt || fail "summary line missing: $(tail -1 bad.txt)"
+# Every refused pose says why; the summary's tally counts the JSON lines' refused_by parts.
+set +e; "$C3PO" certify "$OBJ" --detector manifest --data bad --no-correct --json > bad.jsonl 2>/dev/null; set -e
+python3 - bad.txt bad.jsonl <<'PY' || fail "refusals: human lines, summary tally and JSON refused_by disagree"
+import collections, json, re, sys
+human = open(sys.argv[1]).read().splitlines()
+lines = [json.loads(l) for l in open(sys.argv[2])]
+assert len(lines) == 3 and all(l["refused_by"] and not l["certified"] for l in lines), lines
+refused = [l for l in human if "  not certified  " in l]
+assert len(refused) == 3 and all("  refused by " in l for l in refused), human
+counts = collections.Counter(p for l in lines for p in l["refused_by"])
+summary = [l for l in human if l.startswith("certified 0/3")][0]
+tally = {m.group(1): int(m.group(2)) for m in re.finditer(r"(\w+) (\d+)", summary.split("; refused by ", 1)[1])}
+assert tally == dict(counts), (tally, counts)
+PY
 
 # An unreadable cloud among good ones: reported (exit 2), the others processed.
 cp good/000000.ply ok.ply

@@ -22,6 +22,7 @@
 #include "c3po/method/auto_threshold.hpp"
 #include "c3po/method/certify_batch.hpp"
 #include "c3po/method/pipeline.hpp"
+#include "c3po/method/refusal.hpp"
 #include "evaluation_fixture.hpp"
 #include "test_helpers.hpp"
 
@@ -338,7 +339,8 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(line);
   std::vector<std::string> keys;
   for (auto it = j.begin(); it != j.end(); ++it) keys.push_back(it.key());
-  CHECK(keys == std::vector<std::string>{"cloud", "R", "t", "keypoints", "oc", "nd", "certified", "oc_distance",
+  CHECK(keys == std::vector<std::string>{"cloud", "R", "t", "keypoints", "oc", "nd", "certified", "refused_by",
+                                         "oc_distance",
                                          "keypoint_distance", "nd_set", "nd_set_distances", "eps_oc", "delta_nd",
                                          "iterations", "cost_before", "cost_after", "status", "restarts_tried",
                                          "restart_axis", "restart_angle_deg", "max_outliers",
@@ -364,6 +366,14 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   REQUIRE(j["keypoints"].size() == static_cast<std::size_t>(f.object.num_keypoints()));
   CHECK(j["keypoints"][3][1].get<double>() == e.keypoints(1, 3));
   CHECK(j["certified"].get<bool>() == e.certified());
+  std::vector<std::string> refused_by;
+  for (const CertificatePart part : RefusedBy(e.certificate)) refused_by.push_back(ToString(part));
+  CHECK(j["refused_by"].get<std::vector<std::string>>() == refused_by);
+  CHECK(j["refused_by"].empty() == e.certified());
+  PoseEstimate no_pose = e;   // no pose to certify: the refusal names the registration
+  no_pose.correction.registration = RegistrationStatus::kCollinear;
+  CHECK(nlohmann::json::parse(CertifyJsonLine("a.ply", no_pose))["refused_by"] ==
+        nlohmann::json::array({"registration"}));
   CHECK(j["oc_distance"].get<double>() == e.certificate.oc.max_point_distance);
   CHECK(j["eps_oc"].get<double>() == e.certificate.oc.eps_oc);
   CHECK(j["iterations"].get<int>() == e.correction.iterations);

@@ -5,6 +5,7 @@
 // construction and a shifted pose is not.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -15,6 +16,7 @@
 #include "c3po/method/free_space.hpp"
 #include "c3po/method/global_uniqueness.hpp"
 #include "c3po/method/pipeline.hpp"
+#include "c3po/method/refusal.hpp"
 #include "test_objects.hpp"
 
 using namespace c3po;
@@ -122,6 +124,10 @@ TEST_CASE("global uniqueness: a planted two-fold rival is refused; the discrimin
   CHECK(at_truth.certificate.nd.global.rival_hausdorff > 0.035);
   CHECK(at_truth.certificate.nd.global.rival_hausdorff < 0.06);
   CHECK(at_truth.certificate.nd.global.rival_outliers == 0);
+  // The refusal names the rival search, with the rival's distance and axis (refusal.hpp).
+  CHECK(RefusedBy(at_truth.certificate) == std::vector<CertificatePart>{CertificatePart::kNdGlobal});
+  CHECK(RefusalSummary(at_truth.certificate).rfind("nd_global: a pose 0.0", 0) == 0);
+  CHECK(RefusalSummary(at_truth.certificate).find("leaves 0 points at >= eps_oc") != std::string::npos);
 
   // Switched off, the same estimate is certified (what the test adds).
   PipelineOptions off = options;
@@ -243,6 +249,10 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   CHECK(e.certificate.free_space.checked);
   CHECK_FALSE(e.certificate.free_space.passed);
   CHECK_FALSE(e.certified());
+  CHECK(RefusedBy(e.certificate) == std::vector<CertificatePart>{CertificatePart::kFreeSpace});
+  CHECK(RefusalSummary(e.certificate).rfind("free_space: " + std::to_string(e.certificate.free_space.violations) + " of " +
+                                                std::to_string(e.certificate.free_space.measured) + " measured pixels",
+                                            0) == 0);
 }
 
 TEST_CASE("free space: the whole silhouette shifts together (a pose within the tolerance passes, a turn that overhangs two sides fails)") {
@@ -372,6 +382,7 @@ TEST_CASE("soundness with the frame: no certificate beyond the bound from any st
         ++candidates;
         const double hausdorff = PosedModelHausdorff(object, queries, truth, e.scene_from_model);
         if (k > 0 && hausdorff > bound) turned_refused += !e.certified();
+        CHECK(RefusedBy(e.certificate).empty() == e.certified());   // every refusal is named
         if (!e.certified()) continue;
         ++certified;
         CHECK(hausdorff < bound);
@@ -440,6 +451,7 @@ TEST_CASE("soundness on a table: the segmenter's plane filters rivals, yet no ce
         turned_refused += !e.certified();
         through_refused += e.certificate.free_space.through_support > 0 && !e.certificate.free_space.passed;
       }
+      CHECK(RefusedBy(e.certificate).empty() == e.certified());   // every refusal is named
       if (!e.certified()) continue;
       ++certified;
       CHECK(hausdorff < bound);
@@ -528,7 +540,16 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
   CHECK(through.through_support <= below);
   CHECK(below_on_table > options.max_fraction * box.sample().cols());
   CHECK_FALSE(through.passed);
+  CHECK_FALSE(through.support_passed);
   CHECK_FALSE(test.Passes(sunk, nullptr));   // a rival sunk into the table is no rival
+  // With everything else passed, the refusal names the table (refusal.hpp).
+  Certificate sunk_certificate;
+  sunk_certificate.oc.passed = sunk_certificate.oc.points_passed = true;
+  sunk_certificate.nd.passed = sunk_certificate.nd.sets_passed = true;
+  sunk_certificate.free_space = through;
+  const std::vector<CertificatePart> parts = RefusedBy(sunk_certificate);
+  CHECK(std::find(parts.begin(), parts.end(), CertificatePart::kSupport) != parts.end());
+  CHECK((parts.size() == 1) == through.silhouette_passed);
 
   // Raised 3 cm: floating is not the support test's business (none through).
   Pose raised = truth;
@@ -666,6 +687,10 @@ TEST_CASE("weak motion: a box seen on two whole faces is certified, the faces' m
   CHECK(m.certificate.nd.weak_motion.rivals_found >= 1);
   CHECK(m.certificate.nd.weak_motion.rival_hausdorff > 2 * box.spec().eps_oc);
   CHECK_FALSE(m.certified());
+  CHECK(RefusedBy(m.certificate) == std::vector<CertificatePart>{CertificatePart::kNdWeakMotion});
+  CHECK(RefusalSummary(m.certificate).rfind("nd_weak_motion: the pose moved ", 0) == 0);
+  CHECK(RefusedBy(e.certificate).empty());                                            // discharged
+  CHECK(RefusedBy(strict.certificate) == std::vector<CertificatePart>{CertificatePart::kNdLocal});
 }
 
 TEST_CASE("weak motion: a single face (three weak motions) is never discharged") {
@@ -686,6 +711,7 @@ TEST_CASE("weak motion: a single face (three weak motions) is never discharged")
   CHECK(e.certificate.nd.local.weak_motions >= 3);
   CHECK_FALSE(e.certificate.nd.weak_motion_checked);
   CHECK_FALSE(e.certified());
+  CHECK(RefusedBy(e.certificate) == std::vector<CertificatePart>{CertificatePart::kNdLocal});
 }
 
 TEST_CASE("re-estimation: a flipped start is refuted, the restart at the half-turn is certified") {

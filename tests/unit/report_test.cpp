@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <cstring>
 
@@ -257,6 +258,84 @@ TEST_CASE("3D views: the outliers of each estimate (input points at >= eps_oc) a
   for (const ReportView& v : SelectReportViews(f.object, f.dataset, stale, options.adds_threshold, {2, 2, 100})) {
     CHECK(v.outliers.cols() == 1);
   }
+}
+
+TEST_CASE("3D views: a rejected example says why and shows the rival pose that refused it") {
+  Fixture f;
+  const EvaluationRow& row = *f.evaluation.MainRow();
+  // Evaluate keeps every sample's refusal (RefusalSummary): empty iff certified.
+  int rejected = 0;
+  for (const auto& s : row.samples) {
+    if (!s.ok()) continue;
+    CHECK(s.refusal.empty() == s.certified());
+    CHECK((s.rival_scene_from_model.has_value() && s.certified()) == false);
+    rejected += !s.certified();
+  }
+  // A rejected example with a rival (the evidence nd's global search leaves).
+  EvaluationRow planted = row;
+  SampleResult* target = nullptr;
+  for (auto& s : planted.samples) {
+    if (s.ok() && !target) target = &s;
+  }
+  REQUIRE(target != nullptr);
+  target->oc = true;
+  target->free_space = true;
+  target->nd = false;
+  target->refusal = "nd_global: a pose 0.05 away (180 deg about axis 0) leaves 3 points at >= eps_oc";
+  Pose rival = target->scene_from_model;
+  rival.R = rival.R * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  target->rival_scene_from_model = rival;
+  const double threshold = f.evaluation.options.adds_threshold;
+  const std::vector<ReportView> views = SelectReportViews(f.object, f.dataset, planted, threshold, {0, 100, 300});
+  const ReportView* shown = nullptr;
+  for (const auto& v : views) {
+    if (v.cloud == target->cloud) shown = &v;
+  }
+  REQUIRE(shown != nullptr);
+  CHECK(shown->refusal == target->refusal);
+  const PointSet model = StridedColumns(f.object.sample(), 300);
+  REQUIRE(shown->rival_model.cols() == model.cols());
+  CHECK((shown->rival_model - rival * model).cwiseAbs().maxCoeff() == 0.0);
+  for (const auto& v : views) {
+    if (&v != shown) CHECK(v.rival_model.cols() == 0);   // no rival, no layer content
+  }
+  ReportInput input;
+  input.evaluation = &f.evaluation;
+  input.views = views;
+  const std::string html = ReportHtml(input);
+  CHECK(CheckHtml(html) == "");
+  CHECK(html.find("id=\"layer-rival\"") != std::string::npos);
+  const nlohmann::json data = nlohmann::json::parse(ScriptBody(html, "c3po-views"));
+  const std::size_t k = static_cast<std::size_t>(shown - views.data());
+  CHECK(data["views"][k]["refusal"] == target->refusal);
+  CHECK(Base64Floats(data["views"][k]["rival_model"]) == 3 * static_cast<std::size_t>(model.cols()));
+  MESSAGE(rejected << " rejected samples in the fixture's main row");
+}
+
+TEST_CASE("3D views: a certified pose whose Hausdorff distance is beyond the threshold is a false certificate") {
+  Fixture f;
+  EvaluationRow row = *f.evaluation.MainRow();
+  const double threshold = f.evaluation.options.adds_threshold;
+  SampleResult* target = nullptr;
+  for (auto& s : row.samples) {
+    if (s.ok() && !target) target = &s;
+  }
+  REQUIRE(target != nullptr);
+  // Certified, ADD-S small (a box half-turned about its axis), Hausdorff large.
+  target->oc = target->nd = target->free_space = true;
+  target->adds = 0.1 * threshold;
+  target->hausdorff = 3.0 * threshold;
+  CHECK(target->false_certificate(threshold));
+  target->hausdorff = 0.5 * threshold;
+  CHECK_FALSE(target->false_certificate(threshold));
+  target->hausdorff = std::numeric_limits<double>::quiet_NaN();   // unknown counts, as in the summary
+  CHECK(target->false_certificate(threshold));
+  target->hausdorff = 3.0 * threshold;
+  const std::vector<ReportView> views = SelectReportViews(f.object, f.dataset, row, threshold, {1, 0, 100});
+  REQUIRE(views.size() == 1);   // false certificates are shown first
+  CHECK(views[0].cloud == target->cloud);
+  CHECK(views[0].false_certificate);
+  CHECK(views[0].title.rfind("FALSE certificate", 0) == 0);
 }
 
 TEST_CASE("training logs are read (numeric fields) and plotted; malformed lines are input errors") {

@@ -11,6 +11,7 @@
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"
 #include "c3po/method/pipeline.hpp"
+#include "c3po/method/refusal.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/method/local_nondegeneracy.hpp"
 #include "c3po/eval/metrics.hpp"
@@ -241,6 +242,63 @@ TEST_CASE("degenerate clouds of a non-planar object are never certified") {
   CHECK(whole.certified());
   CHECK(whole.nd.local.min_eigenvalue == doctest::Approx(1.0).epsilon(0.1));
   CHECK(whole.nd.local.model_rank == 6);
+}
+
+TEST_CASE("refusal: every failed part is named with its evidence, nothing when certified") {
+  const ObjectModel object = test::AsymmetricObject(20000);
+  Rng rng(21);
+  Pose truth;
+  truth.R = rng.Rotation();
+  truth.t = {0.02, -0.03, 0.6};
+  const PointSet keypoints = truth * object.keypoints();
+  const PointSet surface = SampleSurface(object.mesh(), 3000, 6);
+  const PointSet cloud = truth * surface;
+  const CertificateOptions options = CertificateOptions::FromObject(object.spec());
+  const double eps_oc = options.eps_oc;
+  using Parts = std::vector<CertificatePart>;
+
+  const Certificate whole = Certify(object, cloud, truth, keypoints, options);
+  REQUIRE(whole.certified());
+  CHECK(RefusedBy(whole).empty());
+  CHECK(RefusalSummary(whole).empty());
+
+  SUBCASE("far points beyond the budget: oc, with the count and the budget") {
+    PointSet far = cloud;
+    for (int j : {7, 8, 9}) far(2, j) += 0.5;
+    const Certificate c = Certify(object, far, truth, keypoints, WithBudget(object, Count(2)));
+    CHECK(RefusedBy(c) == Parts{CertificatePart::kOcPoints});
+    CHECK(RefusalSummary(c).rfind("oc: 3 of 3000 points at >= eps_oc", 0) == 0);
+    CHECK(RefusalSummary(c).find("(budget 2)") != std::string::npos);
+    CHECK(RefusedBy(Certify(object, far, truth, keypoints, WithBudget(object, Count(3)))).empty());
+  }
+  SUBCASE("corrected keypoints off the posed model's: oc_keypoints only") {
+    PointSet off = keypoints;
+    off.col(1) += Eigen::Vector3d(0.0, 2.0 * eps_oc, 0.0);
+    const Certificate c = Certify(object, cloud, truth, off, options);
+    CHECK(c.oc.points_passed);
+    CHECK(RefusedBy(c) == Parts{CertificatePart::kOcKeypoints});
+    CHECK(RefusalSummary(c).rfind("oc_keypoints: keypoints ", 0) == 0);
+  }
+  SUBCASE("a single plane: nd_local, with the unseen motions") {
+    std::vector<Eigen::Index> top;
+    for (Eigen::Index i = 0; i < surface.cols(); ++i) {
+      if (std::abs(surface(2, i) - 0.03) < 1e-9) top.push_back(i);
+    }
+    REQUIRE(top.size() > 50);
+    const Certificate c = Certify(object, truth * Columns(surface, top), truth, keypoints, options);
+    CHECK(RefusedBy(c) == Parts{CertificatePart::kNdLocal});
+    CHECK(RefusalSummary(c).rfind("nd_local: ", 0) == 0);
+    CHECK(RefusalSummary(c).find("motions the accepted points do not constrain") != std::string::npos);
+  }
+  SUBCASE("no points: oc and nd both refuse") {
+    const Certificate c = Certify(object, PointSet(3, 0), truth, keypoints, options);
+    CHECK(RefusedBy(c) == Parts{CertificatePart::kOcPoints, CertificatePart::kNdSets, CertificatePart::kNdLocal});
+    CHECK(RefusalSummary(c).rfind("oc: no input points; nd_sets: no input points; nd_local: ", 0) == 0);
+  }
+  std::vector<std::string> names;   // distinct names for every part
+  for (std::size_t k = 0; k < kCertificatePartCount; ++k) names.push_back(ToString(static_cast<CertificatePart>(k)));
+  CHECK(names == std::vector<std::string>{"oc", "oc_keypoints", "free_space", "support", "nd_sets", "nd_local",
+                                          "nd_weak_motion", "nd_global"});
 }
 
 TEST_CASE("local non-degeneracy: a box seen face-on fails, a corner view passes") {
@@ -499,6 +557,7 @@ TEST_CASE("soundness: no certificate for a pose beyond the bound when at most m 
         ++rival_searches;
         rivals_found += estimate.certificate.nd.global.rivals_found > 0;
       }
+      CHECK(RefusedBy(estimate.certificate).empty() == estimate.certified());
       if (!estimate.certified()) continue;
       ++certified;
       const double hausdorff = PosedModelHausdorff(object, queries, scene.truth, pose);

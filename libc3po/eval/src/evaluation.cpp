@@ -16,6 +16,7 @@
 #include "c3po/method/keypoint_ransac.hpp"
 #include "c3po/method/model_symmetries.hpp"
 #include "c3po/method/pipeline.hpp"
+#include "c3po/method/refusal.hpp"
 
 namespace c3po {
 namespace {
@@ -59,6 +60,21 @@ void ScoreAgainstTruth(const ObjectModel& object, const Pose& truth, const Evalu
   }
 }
 
+// The certificate's decisions and the evidence a report shows.
+void SetCertificate(const Certificate& certificate, SampleResult* sample) {
+  sample->oc = certificate.oc.passed;
+  sample->nd = certificate.nd.passed;
+  sample->free_space = !certificate.free_space.refutes();
+  sample->oc_distance = certificate.oc.max_point_distance;
+  sample->outlier_indices = certificate.oc.outlier_indices;
+  sample->refusal = RefusalSummary(certificate);
+  const GlobalUniqueness& global = certificate.nd.global;
+  sample->rival_scene_from_model.reset();
+  if (certificate.nd.global_checked && !global.passed && global.rival_axis >= 0) {
+    sample->rival_scene_from_model = global.rival_scene_from_model;
+  }
+}
+
 SampleResult FromEstimate(std::size_t index, const std::string& cloud, const PoseEstimate& estimate) {
   if (!estimate.ok()) {
     SampleResult failed = Failure(index, cloud, std::string("registration failed: ") +
@@ -72,11 +88,7 @@ SampleResult FromEstimate(std::size_t index, const std::string& cloud, const Pos
   sample.scene_from_model = estimate.scene_from_model;
   sample.keypoints = estimate.keypoints;
   sample.detected_keypoints = estimate.detected_keypoints;
-  sample.oc = estimate.certificate.oc.passed;
-  sample.nd = estimate.certificate.nd.passed;
-  sample.free_space = !estimate.certificate.free_space.refutes();
-  sample.oc_distance = estimate.certificate.oc.max_point_distance;
-  sample.outlier_indices = estimate.certificate.oc.outlier_indices;
+  SetCertificate(estimate.certificate, &sample);
   sample.milliseconds = estimate.milliseconds;
   return sample;
 }
@@ -118,12 +130,7 @@ SampleResult RefineAndCertify(const ObjectModel& object, const PointSet& cloud,
   refined.certificate = Certify(object, cloud, sample.scene_from_model, sample.keypoints,
                                 options.pipeline.certificate);
   CompleteCertificate(object, cloud, options.pipeline, free_space, &refined);
-  const Certificate& certificate = refined.certificate;
-  sample.oc = certificate.oc.passed;
-  sample.nd = certificate.nd.passed;
-  sample.free_space = !certificate.free_space.refutes();
-  sample.oc_distance = certificate.oc.max_point_distance;
-  sample.outlier_indices = certificate.oc.outlier_indices;
+  SetCertificate(refined.certificate, &sample);
   sample.milliseconds = registration.milliseconds +
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return sample;

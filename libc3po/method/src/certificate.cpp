@@ -101,8 +101,9 @@ void RethresholdObservableCorrectness(ObservableCorrectness* oc, double eps_oc, 
     }
   }
   oc->outlier_count = static_cast<int>(oc->outlier_indices.size());
-  const bool points_ok = d.size() > 0 && oc->outlier_count <= oc->max_outliers;
-  oc->passed = points_ok && (!check_keypoint_agreement || oc->max_keypoint_distance < eps_oc);
+  oc->points_passed = d.size() > 0 && oc->outlier_count <= oc->max_outliers;
+  oc->keypoints_passed = !check_keypoint_agreement || oc->max_keypoint_distance < eps_oc;
+  oc->passed = oc->points_passed && oc->keypoints_passed;
 }
 
 ObservableCorrectness CheckObservableCorrectness(const ObjectModel& object, const PointSet& cloud,

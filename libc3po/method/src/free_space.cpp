@@ -133,7 +133,8 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   result.support_points = static_cast<int>(sample.cols());
   result.through_support = CountThroughSupport(sample, camera_from_model, *view_.depth, view_.camera, *view_.support,
                                                view_.support_distance, tolerance_ + view_.support_distance);
-  if (result.through_support > options_.max_fraction * result.support_points) result.passed = false;
+  result.support_passed = !(result.through_support > options_.max_fraction * result.support_points);
+  result.passed = result.passed && result.support_passed;
   return result;
 }
 
@@ -189,7 +190,8 @@ FreeSpace FreeSpaceTest::CheckSilhouette(const Pose& camera_from_model) const {
   result.shift_u = best.du;
   result.shift_v = best.dv;
   result.reach = reach;
-  result.passed = Excess(best, options_.max_fraction) <= 0.0;
+  result.silhouette_passed = Excess(best, options_.max_fraction) <= 0.0;
+  result.passed = result.silhouette_passed;
   return result;
 }
 

@@ -23,7 +23,8 @@ function countColoured(gl) {
 }
 
 const colours = {input: 0x1f5fd6, outliers: 0xe6194b, certified: 0x2e8b57, rejected: 0xd04040, truth: 0x888888,
-                 keypoints: 0xf58231, detected: 0x911eb4};
+                 rival: 0xffb000, keypoints: 0xf58231, detected: 0x911eb4};
+const layerNames = ['truth', 'rival', 'posed', 'input', 'outliers', 'detected', 'keypoints'];
 
 function makeViewer(THREE, box) {
   const renderer = new THREE.WebGLRenderer({antialias: true});
@@ -103,6 +104,7 @@ function makeViewer(THREE, box) {
     orbit.distance = 3.2 * radius;
     const size = radius * 0.018;
     layers.truth = points(truth, colours.truth, size * 0.8, 0.35);
+    layers.rival = points(decode(view.rival_model), colours.rival, size * 0.8, 0.55);
     layers.posed = points(posed, view.certified ? colours.certified : colours.rejected, size * 0.8, 0.55);
     layers.input = points(input, colours.input, size, 1);
     layers.outliers = points(decode(view.outliers), colours.outliers, size * 1.8, 1);
@@ -112,7 +114,7 @@ function makeViewer(THREE, box) {
       if (detected.length === keypoints.length) layers.detected.add(segments(detected, keypoints, colours.detected));
     }
     layers.keypoints = spheres(keypoints, colours.keypoints, radius * 0.03);
-    for (const name of ['truth', 'posed', 'input', 'outliers', 'detected', 'keypoints']) {
+    for (const name of layerNames) {
       layers[name].visible = document.getElementById('layer-' + name).checked;
       content.add(layers[name]);
     }
@@ -139,7 +141,7 @@ function makeViewer(THREE, box) {
     request();
   }, {passive: false});
   window.addEventListener('resize', request);
-  for (const name of ['truth', 'posed', 'input', 'outliers', 'detected', 'keypoints']) {
+  for (const name of layerNames) {
     document.getElementById('layer-' + name).addEventListener('change', event => {
       if (layers[name]) { layers[name].visible = event.target.checked; request(); }
     });
@@ -153,7 +155,8 @@ function describe(view) {
       (view.false_certificate ? ' (FALSE CERTIFICATE)' : '') + ' \u00b7 ' + view.cloud + ' \u00b7 ' +
       view.row + ' \u00b7 ADD-S ' + (view.adds === null ? 'inf' : view.adds.toPrecision(3)) +
       ' \u00b7 rotation error ' + (view.rotation_error_deg === null ? '-' : view.rotation_error_deg.toFixed(1)) +
-      ' deg \u00b7 oc distance ' + (view.oc_distance === null ? 'inf' : view.oc_distance.toPrecision(3));
+      ' deg \u00b7 oc distance ' + (view.oc_distance === null ? 'inf' : view.oc_distance.toPrecision(3)) +
+      (view.refusal ? ' \u00b7 refused by ' + view.refusal : '');
 }
 
 async function start() {

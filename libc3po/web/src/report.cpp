@@ -47,6 +47,7 @@ json ViewJson(const ReportView& v) {
           {"oc_distance", JsonNumber(v.oc_distance)}, {"input", web::PointsFloat32Base64(v.input)},
           {"outliers", web::PointsFloat32Base64(v.outliers)},
           {"posed_model", web::PointsFloat32Base64(v.posed_model)}, {"truth_model", web::PointsFloat32Base64(v.truth_model)},
+          {"refusal", v.refusal}, {"rival_model", web::PointsFloat32Base64(v.rival_model)},
           {"keypoints", web::PointsFloat32Base64(v.keypoints)}, {"detected_keypoints", web::PointsFloat32Base64(v.detected_keypoints)}};
 }
 
@@ -324,6 +325,8 @@ std::string ViewsHtml(const std::vector<ReportView>& views) {
          "style=\"background:#e6194b\"></span>outliers (input points at &ge; &epsilon;<sub>oc</sub>)</label></span>"
       << "<span><label><input type=\"checkbox\" id=\"layer-posed\" checked><span class=\"swatch\" "
          "style=\"background:#2e8b57\"></span>posed model (red when rejected)</label></span>"
+      << "<span><label><input type=\"checkbox\" id=\"layer-rival\" checked><span class=\"swatch\" "
+         "style=\"background:#ffb000\"></span>rival pose (a second explanation that refused it)</label></span>"
       << "<span><label><input type=\"checkbox\" id=\"layer-truth\"><span class=\"swatch\" "
          "style=\"background:#888\"></span>ground-truth posed model</label></span>"
       << "<span><label><input type=\"checkbox\" id=\"layer-keypoints\" checked><span class=\"swatch\" "
@@ -370,7 +373,7 @@ std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Datas
   std::vector<const SampleResult*> false_certified, certified, rejected;
   for (const auto& s : row.samples) {
     if (!s.ok()) continue;
-    if (s.certified()) (s.adds < adds_threshold ? certified : false_certified).push_back(&s);
+    if (s.certified()) (s.false_certificate(adds_threshold) ? false_certified : certified).push_back(&s);
     else rejected.push_back(&s);
   }
   std::stable_sort(false_certified.begin(), false_certified.end(),
@@ -392,7 +395,7 @@ std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Datas
       view.cloud = s->cloud;
       view.row = row.label;
       view.certified = s->certified();
-      view.false_certificate = view.certified && !(s->adds < adds_threshold);
+      view.false_certificate = s->false_certificate(adds_threshold);
       view.title = std::string(view.false_certificate ? "FALSE certificate" : view.certified ? "certified" : "rejected") +
                    ": " + s->cloud;
       view.adds = s->adds;
@@ -409,6 +412,8 @@ std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Datas
       view.posed_model = s->scene_from_model * model;
       const auto& truth = dataset.entries[s->index].pose;
       if (truth) view.truth_model = *truth * model;
+      view.refusal = s->refusal;
+      if (s->rival_scene_from_model) view.rival_model = *s->rival_scene_from_model * model;
       view.keypoints = s->keypoints;
       view.detected_keypoints = s->detected_keypoints;
       views.push_back(std::move(view));

@@ -27,6 +27,7 @@
 #include <cstddef>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -97,10 +98,19 @@ struct SampleResult {
   // points of B̂), the pose error a certificate must bound (symmetries free).
   double hausdorff = std::numeric_limits<double>::quiet_NaN();
   std::vector<int> outlier_indices;    // input points at >= eps_oc (oc_m's outliers, ascending)
+  // Not certified: the failed parts and their evidence (RefusalSummary), and
+  // the second pose that explains the points when nd's global rival search
+  // refused it (GlobalUniqueness::rival_scene_from_model).
+  std::string refusal;
+  std::optional<Pose> rival_scene_from_model;
   double milliseconds = 0.0;           // estimation + certification time of this method
   bool ok() const { return error.empty(); }
   bool fits_observation() const { return oc && free_space; }   // Certificate::fits_observation
   bool certified() const { return fits_observation() && nd; }
+  // Certified although ADD-S or the Hausdorff distance (NaN counts) is not below `threshold`.
+  bool false_certificate(double threshold) const {
+    return certified() && !(adds < threshold && hausdorff < threshold);
+  }
 };
 
 struct FalseCertificate {

@@ -59,7 +59,9 @@ struct CertificateOptions {
 // oc_m = 1 iff #{x : min_{p in T̂·B̂} ||x - p|| >= eps_oc} <= m (paper eq. 19
 // for m = 0) and, with check_keypoint_agreement, max_i ||y_i - T̂ b_i|| < eps_oc.
 struct ObservableCorrectness {
-  bool passed = false;
+  bool passed = false;                 // points_passed && keypoints_passed
+  bool points_passed = false;          // at most m points at >= eps_oc (and at least one point)
+  bool keypoints_passed = true;        // keypoint agreement (true when not checked)
   double eps_oc = 0.0;
   int max_outliers = 0;                // m resolved for this cloud
   double max_point_distance = 0.0;     // "oc_distance" (100 % quantile)

@@ -56,7 +56,9 @@ struct FreeSpaceOptions {
 
 struct FreeSpace {
   bool checked = false;
-  bool passed = true;
+  bool passed = true;           // silhouette_passed && support_passed
+  bool silhouette_passed = true;  // violations within the budget at the best shift
+  bool support_passed = true;     // few enough model points through the support plane
   int silhouette = 0;          // counted pixels of the rendered silhouette (>= border_pixels inside it)
   int measured = 0;            // of those, at the best shift, with a valid observed depth
   int violations = 0;          // of those, observed depth behind the rendered surface + tolerance

@@ -13,7 +13,9 @@
 //     rejected examples: input cloud, its outliers under the estimate (points
 //     at >= eps_oc, which oc_m tolerates up to the budget m) in another
 //     colour, posed model sample, ground-truth posed model sample, detected
-//     and output keypoints.
+//     and output keypoints; for a rejected example, why (the failed parts
+//     and their evidence) and, when a rival pose explains the points too,
+//     that pose's model sample.
 // Test hooks: document.body.dataset.ready = "1" once the page has set up,
 // window.c3poReport = {views (count), webgl (bool), shown (index), show(i),
 // frames (renders so far), orbit ({theta, phi, distance}), measure (set true
@@ -57,6 +59,8 @@ struct ReportView {
   PointSet outliers;            // its points at >= eps_oc from T̂·B̂ (subsampled)
   PointSet posed_model;         // T̂·B̂ (subsampled)
   PointSet truth_model;         // T*·B̂ (subsampled)
+  std::string refusal;          // rejected: the failed parts and their evidence (RefusalSummary)
+  PointSet rival_model;         // rejected by nd's rival search: the rival pose T'·B̂ (subsampled), else empty
   PointSet keypoints;           // output keypoints
   PointSet detected_keypoints;  // ỹ
 };
@@ -68,8 +72,9 @@ struct ReportViewOptions {
   void Check() const;
 };
 
-// Picks examples with a pose from `row`: false certificates (ADD-S >=
-// adds_threshold) first, worst first, then certified ones in dataset order;
+// Picks examples with a pose from `row`: false certificates (ADD-S or
+// Hausdorff distance >= adds_threshold, SampleResult::false_certificate)
+// first, worst ADD-S first, then certified ones in dataset order;
 // rejected ones in dataset order. Reloads their clouds (unreadable ones are
 // skipped).
 std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Dataset& dataset,

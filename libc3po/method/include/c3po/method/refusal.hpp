@@ -1,0 +1,41 @@
+#pragma once
+// Why a certificate refused a pose: the parts that failed, in the order the
+// pipeline decides them, and their evidence in one line of words
+// (docs/method.md "Why a pose was refused"). `certify` prints them, its JSON
+// lines carry the parts (`refused_by`), the evaluation report shows them
+// next to each rejected example.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "c3po/method/certificate.hpp"
+
+namespace c3po {
+
+enum class CertificatePart {
+  kOcPoints,       // more than m input points at >= eps_oc (or no points)
+  kOcKeypoints,    // corrected keypoints disagree with the posed model's
+  kFreeSpace,      // depth-image inputs: the camera saw through the posed model
+  kSupport,        // depth-image inputs: the posed model reaches into the table
+  kNdSets,         // no indicator set is supported
+  kNdLocal,        // a motion the accepted points do not constrain (first order)
+  kNdWeakMotion,   // the single unseen motion leads to a pose that fits too
+  kNdGlobal,       // a far pose (rival) explains the points too
+};
+inline constexpr std::size_t kCertificatePartCount = static_cast<std::size_t>(CertificatePart::kNdGlobal) + 1;
+
+// "oc", "oc_keypoints", "free_space", "support", "nd_sets", "nd_local",
+// "nd_weak_motion", "nd_global".
+const char* ToString(CertificatePart part);
+
+// The failed parts in the order above; empty iff certificate.certified().
+// The weak-motion check replaces the local part when it ran; the global
+// search runs only when everything else passed, so it is then the only part.
+std::vector<CertificatePart> RefusedBy(const Certificate& certificate);
+
+// "" when certified, else one clause per failed part joined by "; ", each
+// with its evidence (object units), e.g. "nd_global: a pose 0.032 away
+// (180 deg about principal axis 0) leaves 21 points at >= eps_oc".
+std::string RefusalSummary(const Certificate& certificate);
+
+}  // namespace c3po
