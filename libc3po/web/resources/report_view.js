@@ -23,7 +23,7 @@ function countColoured(gl) {
 }
 
 const colours = {input: 0x1f5fd6, outliers: 0xe6194b, certified: 0x2e8b57, rejected: 0xd04040, truth: 0x888888,
-                 rival: 0xffb000, keypoints: 0xf58231, detected: 0x911eb4};
+                 rival: 0x17becf, keypoints: 0xf58231, detected: 0x911eb4};
 const layerNames = ['truth', 'rival', 'posed', 'input', 'outliers', 'detected', 'keypoints'];
 
 function makeViewer(THREE, box) {

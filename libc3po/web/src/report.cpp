@@ -326,7 +326,7 @@ std::string ViewsHtml(const std::vector<ReportView>& views) {
       << "<span><label><input type=\"checkbox\" id=\"layer-posed\" checked><span class=\"swatch\" "
          "style=\"background:#2e8b57\"></span>posed model (red when rejected)</label></span>"
       << "<span><label><input type=\"checkbox\" id=\"layer-rival\" checked><span class=\"swatch\" "
-         "style=\"background:#ffb000\"></span>rival pose (a second explanation that refused it)</label></span>"
+         "style=\"background:#17becf\"></span>rival pose (a second explanation that refused it)</label></span>"
       << "<span><label><input type=\"checkbox\" id=\"layer-truth\"><span class=\"swatch\" "
          "style=\"background:#888\"></span>ground-truth posed model</label></span>"
       << "<span><label><input type=\"checkbox\" id=\"layer-keypoints\" checked><span class=\"swatch\" "
