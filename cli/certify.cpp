@@ -22,6 +22,7 @@
 #include "c3po/method/image_sources.hpp"
 #include "c3po/method/refusal.hpp"
 #include "c3po/object/object_io.hpp"
+#include "c3po/web/certify_report.hpp"
 #include "command.hpp"
 #include "options.hpp"
 #include "progress_bar.hpp"
@@ -47,6 +48,7 @@ struct CertifyCommand {
   std::string bop_csv_path;
   std::string shard;
   std::string poses_path;   // certify given poses (docs/method.md "Certifying given poses")
+  ReportFlags report;       // --report, --views: the certify report (web/certify_report.hpp)
 };
 
 std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
@@ -72,23 +74,53 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
   return std::string(text) + "  refused by " + RefusalSummary(e.certificate);
 }
 
+// "eps_oc = ..., delta_nd = ... (object units; d = ...); m = 2%, robust loss = ...".
+std::string Settings(const CertificateOptions& certificate, const CertifyBatchOptions& options,
+                     const ObjectModel& object) {
+  char text[160];
+  std::snprintf(text, sizeof text, "eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g); ", certificate.eps_oc,
+                certificate.delta_nd, object.diameter());
+  return text + DescribeRobust(certificate, options.pipeline.corrector);
+}
+
 // "; refused by nd_global 36, oc 10": every failed part counted once per
-// refused pose, in the order the certificate decides them; "" when none was.
+// refused pose (CountRefusals), in the order the certificate decides them;
+// "" when none was refused.
 std::string RefusalTally(const CertifyBatchResult& result) {
-  std::vector<int> counts(kCertificatePartCount, 0);
-  int registration = 0;
-  for (const CloudOutcome& outcome : result.outcomes) {
-    if (!outcome.processed() || outcome.estimate.certified()) continue;
-    if (!outcome.estimate.ok()) ++registration;
-    else for (const CertificatePart part : RefusedBy(outcome.estimate.certificate)) ++counts[static_cast<std::size_t>(part)];
-  }
   std::string tally;
-  const auto add = [&](const char* name, int count) {
-    if (count > 0) tally += (tally.empty() ? "; refused by " : ", ") + std::string(name) + " " + std::to_string(count);
-  };
-  add("registration", registration);
-  for (std::size_t k = 0; k < counts.size(); ++k) add(ToString(static_cast<CertificatePart>(k)), counts[k]);
+  for (const RefusalCount& count : CountRefusals(result.outcomes)) {
+    if (count.failed > 0) tally += (tally.empty() ? "; refused by " : ", ") + count.name + " " + std::to_string(count.failed);
+  }
   return tally;
+}
+
+// What was certified, for the report: "BOP DIR, obj_id K", "dataset DIR", ...
+std::string DescribeInputs(const CertifyCommand& cmd, std::size_t sources) {
+  std::string inputs;
+  if (!cmd.bop.dir.empty()) inputs = "BOP " + cmd.bop.dir + ", obj_id " + std::to_string(cmd.bop.options.obj_id);
+  else if (!cmd.data_dir.empty()) inputs = "dataset " + cmd.data_dir;
+  else if (cmd.frame.given()) inputs = "depth " + cmd.frame.depth_path + ", mask " + cmd.frame.mask_path;
+  else inputs = std::to_string(sources) + " cloud file" + (sources == 1 ? "" : "s");
+  if (!cmd.poses_path.empty()) inputs += ", poses " + cmd.poses_path;
+  if (!cmd.shard.empty()) inputs += ", shard " + cmd.shard;
+  return inputs;
+}
+
+// --report FILE: counts by refusing part and 3D examples (web/certify_report.hpp).
+void WriteReportIfAsked(const CertifyCommand& cmd, const ObjectModel& object, const std::vector<CloudSource>& sources,
+                        const CertifyBatchResult& result, const std::string& settings) {
+  if (cmd.report.path.empty()) return;
+  ReportViewOptions views;
+  views.certified = views.rejected = cmd.report.views;
+  CertifyReportInput input;
+  input.object_name = object.spec().name;
+  input.diameter = object.diameter();
+  input.inputs = DescribeInputs(cmd, sources.size());
+  input.settings = settings;
+  input.result = &result;
+  input.views = CertifyReportViews(object, sources, result, views);
+  WriteCertifyReport(cmd.report.path, input);
+  std::cerr << "wrote " << cmd.report.path << " (" << input.views.size() << " 3D examples)\n";
 }
 
 // The certify JSON line of a given pose (with the source's keys: a BOP
@@ -191,6 +223,7 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
     }
     WriteFileAtomically(cmd.bop_csv_path, BopCsv(BopResultRows(matched.sources, result, written)));
   }
+  WriteReportIfAsked(cmd, object, matched.sources, result, Settings(result.certificate, options, object));
   if (!cmd.output_path.empty()) {
     WriteFileAtomically(cmd.output_path, json_lines.str());
   } else if (cmd.json) {
@@ -221,6 +254,7 @@ int Run(const CertifyCommand& cmd) {
   if (cmd.poses_path.empty() && detectors != 1) {
     throw InputError("give exactly one of --model FILE, --detector NAME or --poses FILE");
   }
+  cmd.report.Check();
   const ObjectModel object = LoadObject(cmd.object_path);
   CertifyBatchOptions options;
   options.pipeline.correct = !cmd.no_correct;
@@ -293,13 +327,12 @@ int Run(const CertifyCommand& cmd) {
   } else if (cmd.json) {
     std::cout << json_lines.str();
   }
+  const std::string settings = Settings(result.certificate, options, object);
   if (!cmd.json) {
-    std::printf("certified %d/%zu (oc %d, nd %d, errors %d); eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g); "
-                "%s%s\n",
-                result.certified, sources.size(), result.oc, result.nd, result.errors, result.certificate.eps_oc,
-                result.certificate.delta_nd, object.diameter(),
-                DescribeRobust(result.certificate, options.pipeline.corrector).c_str(), RefusalTally(result).c_str());
+    std::printf("certified %d/%zu (oc %d, nd %d, errors %d); %s%s\n", result.certified, sources.size(), result.oc,
+                result.nd, result.errors, settings.c_str(), RefusalTally(result).c_str());
   }
+  WriteReportIfAsked(cmd, object, sources, result, settings);
   if (result.errors > 0) return 2;
   return result.certified == static_cast<int>(sources.size()) ? 0 : 1;
 }
@@ -329,6 +362,8 @@ RunFunction SetupCertify(CLI::App& command) {
                      "Write BOP results CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm; score: certified first); "
                      "with --poses one row per instance: its chosen hypothesis, else its best fit");
   AddShardOption(command, &cmd->shard, "clouds (by image for --bop, by cloud or manifest line otherwise)");
+  AddReportOptions(command, &cmd->report,
+                   "poses certified and refused by each certificate part, 3D examples with the reason and the rival pose");
   return [cmd]() { return Run(*cmd); };
 }
 

@@ -53,9 +53,8 @@ struct EvalCommand {
   std::string json_path;
   std::string samples_path;   // --samples: per-sample rows for c3po merge --eval
   std::string shard;          // --shard K/N
-  std::string report_path;
+  ReportFlags report;
   std::vector<std::string> training_logs;
-  int views = 3;
   int worst = 5;
   // BOP input (issue 15): converted to a temporary dataset.
   BopFlags bop;
@@ -236,7 +235,7 @@ int Run(const EvalCommand& cmd) {
     }
   }
   EvaluationOptions options = MakeOptions(cmd, object, diameter);
-  if (cmd.views < 0) throw InputError("--views must be >= 0");
+  cmd.report.Check();
   const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
   const std::string empty_part = "this part holds no clouds (choose N at most the number of " +
                                  std::string(cmd.bop.dir.empty() ? "manifest lines)" : "images with usable instances)");
@@ -274,7 +273,7 @@ int Run(const EvalCommand& cmd) {
   std::vector<EvaluatedDetector> detectors;
   for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});
   std::vector<TrainingLog> logs;
-  if (!cmd.report_path.empty()) logs = ReadTrainingLogs(cmd, loaded);   // fail before the long work
+  if (!cmd.report.path.empty()) logs = ReadTrainingLogs(cmd, loaded);   // fail before the long work
   for (const ModelSymmetry& symmetry :
        ObjectSymmetries(cmd.symmetry, object, "rotation and translation errors to the nearest symmetric truth")) {
     options.symmetries.push_back(symmetry.model_from_model);
@@ -300,19 +299,19 @@ int Run(const EvalCommand& cmd) {
     WriteFileAtomically(cmd.json_path, EvaluationJson(evaluation));
     std::cerr << "wrote " << cmd.json_path << "\n";
   }
-  if (!cmd.report_path.empty()) {
+  if (!cmd.report.path.empty()) {
     ReportInput report;
     report.evaluation = &evaluation;
     report.training = std::move(logs);
     report.command_line = CommandLine(cmd);
     ReportViewOptions view_options;
-    view_options.certified = cmd.views;
-    view_options.rejected = cmd.views;
+    view_options.certified = cmd.report.views;
+    view_options.rejected = cmd.report.views;
     if (const EvaluationRow* row = evaluation.MainRow()) {
       report.views = SelectReportViews(object, dataset, *row, options.adds_threshold, view_options);
     }
-    WriteReport(cmd.report_path, report);
-    std::cerr << "wrote " << cmd.report_path << " (" << report.views.size() << " 3D examples, "
+    WriteReport(cmd.report.path, report);
+    std::cerr << "wrote " << cmd.report.path << " (" << report.views.size() << " 3D examples, "
               << report.training.size() << " training logs)\n";
   }
   return 0;
@@ -354,10 +353,9 @@ RunFunction SetupEval(CLI::App& command) {
   command.add_option("--samples", cmd->samples_path,
                      "Write the per-sample rows as JSON lines (atomically), for c3po merge --eval of --shard parts");
   AddShardOption(command, &cmd->shard, "clouds (by manifest line for --data, by image for --bop)");
-  command.add_option("--report", cmd->report_path, "Write a self-contained HTML report");
+  AddReportOptions(command, &cmd->report, "the results table, soundness, ADD-S plots, training curves, 3D examples");
   command.add_option("--training-log", cmd->training_logs,
                      "Training log (JSON lines) for the report; MODEL.log.jsonl next to each model is found automatically")->allow_extra_args(false);
-  command.add_option("--views", cmd->views, "3D examples in the report: this many certified and rejected (default 3)");
   command.add_option("--worst", cmd->worst, "False certificates listed per row (default 5)");
   return [cmd]() { return Run(*cmd); };
 }

@@ -307,6 +307,15 @@ void AddCameraCloudOptions(CLI::App& command, CameraCloudFlags* flags, const std
       ->capture_default_str();
 }
 
+void ReportFlags::Check() const {
+  if (views < 0) throw InputError("--views must be >= 0");
+}
+
+void AddReportOptions(CLI::App& command, ReportFlags* flags, const std::string& contents) {
+  command.add_option("--report", flags->path, "Write a self-contained HTML report: " + contents);
+  command.add_option("--views", flags->views, "3D examples in the report: this many certified and rejected (default 3)");
+}
+
 void AddShardOption(CLI::App& command, std::string* shard, const std::string& what) {
   command.add_option("--shard", *shard, "Process part K of N (K/N, 1-based) of the " + what +
                                             ": disjoint, deterministic; join with c3po merge");

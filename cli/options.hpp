@@ -25,6 +25,14 @@
 
 namespace c3po::cli {
 
+// --report FILE and --views N of certify and eval (the HTML reports).
+struct ReportFlags {
+  std::string path;   // "" = no report
+  int views = 3;      // certified and rejected 3D examples
+  void Check() const; // throws InputError for --views < 0
+};
+void AddReportOptions(CLI::App& command, ReportFlags* flags, const std::string& contents);
+
 enum class AutoEpsOc { kRefused, kAllowed };
 // --eps-oc, --delta-nd as typed ("" = the object's value).
 struct ThresholdFlags {

@@ -1,5 +1,5 @@
 // Browser test of the evaluation report written by `c3po eval --report`.
-// Usage: node report_page.mjs PLAYWRIGHT_CORE_DIR REPORT.html EXPECTED_ROWS PROFILE_DIR
+// Usage: node report_page.mjs PLAYWRIGHT_CORE_DIR REPORT.html EXPECTED_ROWS|certify PROFILE_DIR
 // Checks: loads without console errors or network requests; the results
 // table has EXPECTED_ROWS rows; the soundness section and the SVG plots are
 // there; the 3D view has a WebGL canvas that draws points (non-background
@@ -10,6 +10,8 @@ import { pathToFileURL } from 'node:url';
 
 const [playwrightDir, pagePath, rowsText, profileDir] = process.argv.slice(2);
 const { chromium } = await import(pathToFileURL(path.join(playwrightDir, 'node_modules/playwright-core/index.mjs')).href);
+// EXPECTED_ROWS "certify": the page of `c3po certify --report` (no results table).
+const certifyReport = rowsText === 'certify';
 const expectedRows = Number(rowsText);
 
 function check(condition, message) {
@@ -43,10 +45,15 @@ try {
   await page.goto(pathToFileURL(path.resolve(pagePath)).href);
   await page.waitForFunction(() => document.body.dataset.ready === '1', null, {timeout: 60000});
 
-  const rows = await page.locator('table#results tbody tr').count();
-  check(rows === expectedRows, `results table has ${expectedRows} rows (found ${rows})`);
-  check(await page.locator('#soundness #false-certificates').count() === 1, 'soundness figure present');
-  check(await page.locator('#adds-plots svg.chart').count() >= 2, 'ADD-S plots present');
+  if (certifyReport) {
+    const rows = await page.locator('table#refusals tbody tr').count();
+    check(rows >= 2, `refusal table lists certified and refused poses (${rows} rows)`);
+  } else {
+    const rows = await page.locator('table#results tbody tr').count();
+    check(rows === expectedRows, `results table has ${expectedRows} rows (found ${rows})`);
+    check(await page.locator('#soundness #false-certificates').count() === 1, 'soundness figure present');
+    check(await page.locator('#adds-plots svg.chart').count() >= 2, 'ADD-S plots present');
+  }
 
   const state = await page.evaluate(() => ({views: window.c3poReport.views, webgl: window.c3poReport.webgl,
                                              error: window.c3poReport.error}));
@@ -79,7 +86,9 @@ try {
   if (state.views > 1) {
     await buttons.nth(state.views - 1).click();
     check(await page.evaluate(() => window.c3poReport.shown) === state.views - 1, 'clicking a button shows its example');
-    check((await page.locator('#view-info').textContent()).includes('ADD-S'), 'example info shows its ADD-S');
+    if (!certifyReport) {
+      check((await page.locator('#view-info').textContent()).includes('ADD-S'), 'example info shows its ADD-S');
+    }
   }
 
   // Every rejected example says why (the failed certificate parts), a certified one does not.

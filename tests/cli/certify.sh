@@ -44,6 +44,16 @@ summary = [l for l in human if l.startswith("certified 0/3")][0]
 tally = {m.group(1): int(m.group(2)) for m in re.finditer(r"(\w+) (\d+)", summary.split("; refused by ", 1)[1])}
 assert tally == dict(counts), (tally, counts)
 PY
+# --report: counts by refusing part and 3D examples; a bad --views or an unwritable path is an input error.
+set +e; "$C3PO" certify "$OBJ" --detector manifest --data bad --no-correct --report report.html --views 2 \
+  > /dev/null 2> report.err; status=$?; set -e
+[ $status -eq 1 ] || fail "--report: expected exit 1 (nothing certified), got $status"
+grep -q 'id="refusals"' report.html || fail "--report: no refusal table"
+grep -q "wrote report.html (2 3D examples)" report.err || fail "--report: $(cat report.err)"
+set +e; "$C3PO" certify "$OBJ" --detector manifest --data bad --report r2.html --views -1 > /dev/null 2> views.err; s1=$?
+"$C3PO" certify "$OBJ" --detector manifest --data bad --report missing/r.html > /dev/null 2> path.err; s2=$?; set -e
+[ $s1 -eq 2 ] && [ ! -e r2.html ] || fail "--views -1: expected exit 2 and no report, got $s1"
+[ $s2 -eq 2 ] && grep -q "missing/r.html" path.err || fail "unwritable --report: exit $s2, $(cat path.err)"
 
 # An unreadable cloud among good ones: reported (exit 2), the others processed.
 cp good/000000.ply ok.ply

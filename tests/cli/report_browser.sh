@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The evaluation report in headless Chromium (Debian package `chromium`,
+# The evaluation and certify reports in headless Chromium (Debian package `chromium`,
 # driven by npm playwright-core, like annotate_browser.sh): loads without
 # console errors or network requests, shows the table and a WebGL 3D view that
 # draws, orbits on drag and switches examples. Skips (77) without chromium,
@@ -19,3 +19,9 @@ OBJECT="$SRC/annotations/mug.json"
 
 # KeyPo, + ICP, + RANSAC + ICP, + corrector for the one detector.
 node "$SRC/tests/browser/report_page.mjs" "$PW_DIR" report.html 4 "$WORK/chromium-profile"
+
+# The certify report (no ground truth): the refusal table and the same 3D view.
+status=0
+"$C3PO" certify "$OBJECT" --data data --detector manifest --report certify.html --views 2 > certify.txt 2>&1 || status=$?
+[ $status -le 1 ] && [ -s certify.html ] || { cat certify.txt; echo "FAIL: c3po certify --report"; exit 1; }
+node "$SRC/tests/browser/report_page.mjs" "$PW_DIR" certify.html certify "$WORK/chromium-profile-certify"

@@ -28,6 +28,14 @@ for c in certify eval selftrain; do
   [ $c == selftrain ] && [ $pointnet -eq 0 ] && continue
   "$C3PO" $c --help | grep -q -- "--solver" || fail "$c --help lacks --solver"
 done
+# The HTML reports (cli/options.* AddReportOptions): the same flags and the same error.
+for c in certify eval; do
+  "$C3PO" $c --help > help.txt 2>&1
+  grep -q -- "--report" help.txt && grep -q -- "--views" help.txt || fail "$c --help lacks --report/--views"
+  "$C3PO" $c "$OBJ" --detector svd --data nowhere --report r.html --views -2 > /dev/null 2> views.err
+  status=$?
+  [ $status -eq 2 ] && grep -q "views must be >= 0" views.err || fail "$c --views -2: exit $status, $(cat views.err)"
+done
 "$C3PO" certify --help | grep -q "auto" || fail "certify --eps-oc does not offer auto"
 "$C3PO" eval --help | grep -- "--eps-oc" | grep -q "auto" && fail "eval --eps-oc offers auto, which eval does not do"
 

@@ -14,6 +14,8 @@
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/eval/evaluation.hpp"
+#include "c3po/method/refusal.hpp"
+#include "c3po/web/certify_report.hpp"
 #include "c3po/web/report.hpp"
 #include "evaluation_fixture.hpp"
 #include "test_helpers.hpp"
@@ -336,6 +338,120 @@ TEST_CASE("3D views: a certified pose whose Hausdorff distance is beyond the thr
   CHECK(views[0].cloud == target->cloud);
   CHECK(views[0].false_certificate);
   CHECK(views[0].title.rfind("FALSE certificate", 0) == 0);
+}
+
+namespace {
+
+// An outcome whose certificate fails exactly `parts` (or nothing).
+CloudOutcome Refused(const std::vector<CertificatePart>& parts) {
+  CloudOutcome outcome;
+  Certificate& c = outcome.estimate.certificate;
+  c.oc.points_passed = c.oc.keypoints_passed = c.oc.passed = true;
+  c.nd.sets_passed = c.nd.passed = true;
+  for (const CertificatePart part : parts) {
+    switch (part) {
+      case CertificatePart::kOcPoints: c.oc.points_passed = c.oc.passed = false; break;
+      case CertificatePart::kFreeSpace:
+        c.free_space.checked = true;
+        c.free_space.silhouette_passed = c.free_space.passed = false;
+        break;
+      case CertificatePart::kNdGlobal:
+        c.nd.global_checked = true;
+        c.nd.global.passed = c.nd.passed = false;
+        break;
+      default: FAIL("not used here");
+    }
+  }
+  return outcome;
+}
+
+}  // namespace
+
+TEST_CASE("certify report: examples are the first certified ones and one rejected per first refusing part") {
+  using P = CertificatePart;
+  std::vector<CloudOutcome> outcomes = {Refused({P::kOcPoints}), Refused({}), Refused({P::kOcPoints, P::kFreeSpace}),
+                                        Refused({P::kNdGlobal}), Refused({}), Refused({P::kFreeSpace}),
+                                        Refused({P::kOcPoints}), Refused({})};
+  outcomes.push_back(Refused({}));
+  outcomes.back().failure = CloudOutcome::Failure::kLoad;   // unreadable: never an example
+  for (std::size_t i = 0; i < outcomes.size(); ++i) {
+    CAPTURE(i);
+    CHECK(outcomes[i].certified() == (i == 1 || i == 4 || i == 7));
+  }
+  // Two certified (in source order); rejected: oc first (0), free space (5), nd_global (3), then source order (2).
+  CHECK(SelectCertifyExamples(outcomes, 2, 4) == std::vector<std::size_t>{1, 4, 0, 5, 3, 2});
+  CHECK(SelectCertifyExamples(outcomes, 0, 2) == std::vector<std::size_t>{0, 5});
+  CHECK(SelectCertifyExamples(outcomes, 5, 9) == std::vector<std::size_t>{1, 4, 7, 0, 5, 3, 2, 6});
+  CHECK(SelectCertifyExamples(outcomes, 0, 0).empty());
+  // The counts behind the table: `first` sums to the refused poses, `failed` counts every part.
+  int first = 0;
+  for (const RefusalCount& count : CountRefusals(outcomes)) {
+    first += count.first;
+    if (count.name == "oc") CHECK((count.first == 3 && count.failed == 3));
+    if (count.name == "free_space") CHECK((count.first == 1 && count.failed == 2));
+    if (count.name == "nd_global") CHECK((count.first == 1 && count.failed == 1));
+  }
+  CHECK(first == 5);
+}
+
+TEST_CASE("certify report: each example is its source's cloud with the estimate's outliers, reason and rival") {
+  Fixture f;
+  CertifyBatchOptions options;
+  options.pipeline.certificate = CertificateOptions::FromObject(f.object.spec());
+  options.pipeline.certificate.eps_oc = 0.004 * f.object.diameter();   // tight: outliers and refusals
+  const std::vector<CloudSource> sources = DatasetSources(f.dataset);
+  const CertifyBatchResult result = CertifyBatch(f.object, sources, nullptr, options);
+  REQUIRE(result.outcomes.size() == sources.size());
+  ReportViewOptions view_options;
+  view_options.certified = view_options.rejected = 10;
+  view_options.max_points = 100000;
+  const std::vector<ReportView> views = CertifyReportViews(f.object, sources, result, view_options);
+  const std::vector<std::size_t> chosen = SelectCertifyExamples(result.outcomes, 10, 10);
+  REQUIRE(views.size() == chosen.size());
+  int rejected = 0;
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const CloudOutcome& outcome = result.outcomes[chosen[k]];
+    const PoseEstimate& e = outcome.estimate;
+    const PointSet cloud = f.dataset.LoadCloud(sources[chosen[k]].dataset_index);
+    CAPTURE(views[k].cloud);
+    CHECK(views[k].cloud == sources[chosen[k]].name);
+    CHECK(views[k].certified == e.certified());
+    CHECK((views[k].input - cloud).cwiseAbs().maxCoeff() == 0.0);
+    REQUIRE(views[k].outliers.cols() == static_cast<Eigen::Index>(e.certificate.oc.outlier_indices.size()));
+    for (std::size_t i = 0; i < e.certificate.oc.outlier_indices.size(); ++i) {
+      CHECK((views[k].outliers.col(static_cast<Eigen::Index>(i)) - cloud.col(e.certificate.oc.outlier_indices[i]))
+                .norm() == 0.0);
+    }
+    CHECK(views[k].refusal == (e.ok() ? RefusalSummary(e.certificate) : "registration failed"));
+    CHECK(views[k].refusal.empty() == e.certified());
+    const bool rival = e.certificate.nd.global_checked && !e.certificate.nd.global.passed;
+    CHECK((views[k].rival_model.cols() > 0) == rival);
+    CHECK(views[k].truth_model.cols() > 0);   // the manifest's ground truth
+    CHECK(std::isnan(views[k].adds));
+    rejected += !views[k].certified;
+  }
+  CHECK(rejected > 0);
+  CertifyReportInput input;
+  input.object_name = f.object.spec().name;
+  input.diameter = f.object.diameter();
+  input.inputs = "dataset data";
+  input.settings = "eps_oc = tight";
+  input.result = &result;
+  input.views = views;
+  const std::string html = CertifyReportHtml(input);
+  CHECK(CheckHtml(html) == "");
+  CHECK(html.find("<b id=\"certified-count\">" + std::to_string(result.certified) + "</b> of " +
+                  std::to_string(sources.size())) != std::string::npos);
+  CHECK(html.find("id=\"refusals\"") != std::string::npos);
+  for (const RefusalCount& count : CountRefusals(result.outcomes)) {
+    const bool listed = html.find("<td>refused by " + count.name + "</td><td>" + std::to_string(count.first) +
+                                  "</td><td>" + std::to_string(count.failed) + "</td>") != std::string::npos;
+    CHECK(listed == (count.failed > 0));
+  }
+  const nlohmann::json data = nlohmann::json::parse(ScriptBody(html, "c3po-views"));
+  REQUIRE(data["views"].size() == views.size());
+  CHECK(data["views"][0]["adds"].is_null());
+  CHECK_THROWS_AS(CertifyReportHtml(CertifyReportInput{}), std::invalid_argument);
 }
 
 TEST_CASE("training logs are read (numeric fields) and plotted; malformed lines are input errors") {

@@ -18,14 +18,6 @@ nlohmann::ordered_json RotationJson(const Eigen::Matrix3d& R) {
   return {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
 }
 
-// The failed parts (refusal.hpp); ["registration"] when there is no pose to certify.
-nlohmann::ordered_json RefusedByJson(const PoseEstimate& e) {
-  if (!e.ok()) return {"registration"};
-  nlohmann::ordered_json parts = nlohmann::ordered_json::array();
-  for (const CertificatePart part : RefusedBy(e.certificate)) parts.push_back(ToString(part));
-  return parts;
-}
-
 // "cloud", then the provenance keys of image inputs.
 nlohmann::ordered_json SourceKeys(const CloudSource& source, const CloudOutcome& outcome) {
   nlohmann::ordered_json line;
@@ -66,7 +58,7 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["oc"] = e.certificate.oc.passed;
   line["nd"] = e.certificate.nd.passed;
   line["certified"] = e.certified();
-  line["refused_by"] = RefusedByJson(e);
+  line["refused_by"] = RefusedByNames(e);
   line["oc_distance"] = FiniteOrNull(e.certificate.oc.max_point_distance);
   line["keypoint_distance"] = e.certificate.oc.max_keypoint_distance;
   line["nd_set"] = e.certificate.nd.passing_set;

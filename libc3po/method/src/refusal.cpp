@@ -94,6 +94,28 @@ std::vector<CertificatePart> RefusedBy(const Certificate& c) {
   return parts;
 }
 
+std::vector<std::string> RefusedByNames(const PoseEstimate& estimate) {
+  if (!estimate.ok()) return {"registration"};
+  std::vector<std::string> names;
+  for (const CertificatePart part : RefusedBy(estimate.certificate)) names.emplace_back(ToString(part));
+  return names;
+}
+
+std::vector<RefusalCount> CountRefusals(const std::vector<CloudOutcome>& outcomes) {
+  std::vector<RefusalCount> counts = {{"registration"}};
+  for (std::size_t k = 0; k < kCertificatePartCount; ++k) counts.push_back({ToString(static_cast<CertificatePart>(k))});
+  for (const CloudOutcome& outcome : outcomes) {
+    if (!outcome.processed() || outcome.estimate.certified()) continue;
+    const std::vector<std::string> names = RefusedByNames(outcome.estimate);
+    for (RefusalCount& count : counts) {
+      const auto at = std::find(names.begin(), names.end(), count.name);
+      count.failed += at != names.end();
+      count.first += at == names.begin() && at != names.end();
+    }
+  }
+  return counts;
+}
+
 std::string RefusalSummary(const Certificate& c) {
   std::string summary;
   for (const CertificatePart part : RefusedBy(c)) {

@@ -149,14 +149,18 @@ function makeViewer(THREE, box) {
   return {show, orbit, request, canvas};
 }
 
+// Unknown numbers (no ground truth: a certify report) are null and left out.
 function describe(view) {
   const info = document.getElementById('view-info');
-  info.textContent = (view.certified ? 'CERTIFIED' : 'not certified') +
-      (view.false_certificate ? ' (FALSE CERTIFICATE)' : '') + ' \u00b7 ' + view.cloud + ' \u00b7 ' +
-      view.row + ' \u00b7 ADD-S ' + (view.adds === null ? 'inf' : view.adds.toPrecision(3)) +
-      ' \u00b7 rotation error ' + (view.rotation_error_deg === null ? '-' : view.rotation_error_deg.toFixed(1)) +
-      ' deg \u00b7 oc distance ' + (view.oc_distance === null ? 'inf' : view.oc_distance.toPrecision(3)) +
-      (view.refusal ? ' \u00b7 refused by ' + view.refusal : '');
+  const parts = [(view.certified ? 'CERTIFIED' : 'not certified') + (view.false_certificate ? ' (FALSE CERTIFICATE)' : ''),
+                 view.cloud];
+  if (view.row) parts.push(view.row);
+  if (view.adds !== null) parts.push('ADD-S ' + view.adds.toPrecision(3));
+  if (view.rotation_error_deg !== null) parts.push('rotation error ' + view.rotation_error_deg.toFixed(1) + ' deg');
+  if (view.truth_hausdorff !== null) parts.push('Hausdorff to the truth ' + view.truth_hausdorff.toPrecision(3));
+  parts.push('oc distance ' + (view.oc_distance === null ? 'inf' : view.oc_distance.toPrecision(3)));
+  if (view.refusal) parts.push('refused by ' + view.refusal);
+  info.textContent = parts.join(' \u00b7 ');
 }
 
 async function start() {

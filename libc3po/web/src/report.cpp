@@ -12,9 +12,8 @@
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
-#include "embedded_resources.hpp"
 #include "report_svg.hpp"
-#include "three_js.hpp"
+#include "report_views.hpp"
 #include "web_text.hpp"
 
 namespace c3po {
@@ -34,21 +33,6 @@ std::string Number(const char* format, double value) {
   char text[64];
   std::snprintf(text, sizeof text, format, value);
   return text;
-}
-
-json JsonNumber(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
-
-// ---- 3D view data: little-endian float32 xyz, base64 ----
-
-json ViewJson(const ReportView& v) {
-  return {{"title", v.title}, {"cloud", v.cloud}, {"row", v.row}, {"certified", v.certified},
-          {"false_certificate", v.false_certificate}, {"adds", JsonNumber(v.adds)},
-          {"rotation_error_deg", JsonNumber(v.rotation_error * kDegrees)},
-          {"oc_distance", JsonNumber(v.oc_distance)}, {"input", web::PointsFloat32Base64(v.input)},
-          {"outliers", web::PointsFloat32Base64(v.outliers)},
-          {"posed_model", web::PointsFloat32Base64(v.posed_model)}, {"truth_model", web::PointsFloat32Base64(v.truth_model)},
-          {"refusal", v.refusal}, {"rival_model", web::PointsFloat32Base64(v.rival_model)},
-          {"keypoints", web::PointsFloat32Base64(v.keypoints)}, {"detected_keypoints", web::PointsFloat32Base64(v.detected_keypoints)}};
 }
 
 // ---- page sections ----
@@ -310,33 +294,6 @@ std::string TrainingHtml(const std::vector<TrainingLog>& logs) {
   return out.str();
 }
 
-std::string ViewsHtml(const std::vector<ReportView>& views) {
-  std::ostringstream out;
-  out << "<section id=\"views\">\n<h2>Examples in 3D</h2>\n";
-  if (views.empty()) {
-    out << "<p class=\"note\">No examples to show.</p>\n</section>\n";
-    return out.str();
-  }
-  out << "<p class=\"note\">Drag to orbit, wheel to zoom. Pick an example:</p>\n<div id=\"view-buttons\"></div>\n"
-      << "<div class=\"legend\">"
-      << "<span><label><input type=\"checkbox\" id=\"layer-input\" checked><span class=\"swatch\" "
-         "style=\"background:#1f5fd6\"></span>input cloud</label></span>"
-      << "<span><label><input type=\"checkbox\" id=\"layer-outliers\" checked><span class=\"swatch\" "
-         "style=\"background:#e6194b\"></span>outliers (input points at &ge; &epsilon;<sub>oc</sub>)</label></span>"
-      << "<span><label><input type=\"checkbox\" id=\"layer-posed\" checked><span class=\"swatch\" "
-         "style=\"background:#2e8b57\"></span>posed model (red when rejected)</label></span>"
-      << "<span><label><input type=\"checkbox\" id=\"layer-rival\" checked><span class=\"swatch\" "
-         "style=\"background:#17becf\"></span>rival pose (a second explanation that refused it)</label></span>"
-      << "<span><label><input type=\"checkbox\" id=\"layer-truth\"><span class=\"swatch\" "
-         "style=\"background:#888\"></span>ground-truth posed model</label></span>"
-      << "<span><label><input type=\"checkbox\" id=\"layer-keypoints\" checked><span class=\"swatch\" "
-         "style=\"background:#f58231\"></span>output keypoints</label></span>"
-      << "<span><label><input type=\"checkbox\" id=\"layer-detected\" checked><span class=\"swatch\" "
-         "style=\"background:#911eb4\"></span>detected keypoints</label></span>"
-      << "</div>\n<div id=\"view3d\"></div>\n<div id=\"view-info\"></div>\n</section>\n";
-  return out.str();
-}
-
 }  // namespace
 
 TrainingLog ReadTrainingLog(const std::string& path, const std::string& label) {
@@ -413,6 +370,7 @@ std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Datas
       const auto& truth = dataset.entries[s->index].pose;
       if (truth) view.truth_model = *truth * model;
       view.refusal = s->refusal;
+      view.truth_hausdorff = s->hausdorff;
       if (s->rival_scene_from_model) view.rival_model = *s->rival_scene_from_model * model;
       view.keypoints = s->keypoints;
       view.detected_keypoints = s->detected_keypoints;
@@ -425,26 +383,15 @@ std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Datas
 std::string ReportHtml(const ReportInput& input) {
   if (!input.evaluation) throw std::invalid_argument("ReportHtml: no evaluation");
   const Evaluation& e = *input.evaluation;
-  json views = json::array();
-  for (const auto& view : input.views) views.push_back(ViewJson(view));
-  const std::string three = input.views.empty() ? std::string() : web::ThreeJsForPage();
-
   std::ostringstream page;
-  page << "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-       << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-       << "<link rel=\"icon\" href=\"data:,\">\n<title>" << HtmlEscape(input.title + ": " + e.object_name)
-       << "</title>\n<style>\n" << resources::ReportCss() << "</style>\n</head>\n<body>\n";
+  page << web::ReportPageStart(input.title + ": " + e.object_name);
   page << "<h1>" << HtmlEscape(input.title) << ": " << HtmlEscape(e.object_name) << "</h1>\n<p class=\"meta\">Dataset <code>"
        << HtmlEscape(e.dataset_dir) << "</code>, " << e.clouds << " clouds, object diameter d = "
        << Number("%.4g", e.diameter) << ".";
   if (!input.command_line.empty()) page << "<br>Command: <code>" << HtmlEscape(input.command_line) << "</code>";
   page << "</p>\n" << SoundnessHtml(e) << "<section id=\"table\">\n<h2>Results</h2>\n" << TableHtml(e)
        << SettingsHtml(e) << "</section>\n" << AddsPlotsHtml(e) << TrainingHtml(input.training)
-       << ViewsHtml(input.views);
-  page << "<script type=\"text/plain\" id=\"c3po-three\">" << three << "</script>\n";
-  page << "<script type=\"application/json\" id=\"c3po-views\">"
-       << web::ScriptSafe(json{{"views", views}}.dump()) << "</script>\n";
-  page << "<script type=\"module\">\n" << resources::ReportViewJs() << "</script>\n</body>\n</html>\n";
+       << web::ReportViewsHtml(input.views) << web::ReportPageEnd(input.views);
   return page.str();
 }
 

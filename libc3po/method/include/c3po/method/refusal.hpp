@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "c3po/method/certificate.hpp"
+#include "c3po/method/certify_batch.hpp"
+#include "c3po/method/pipeline.hpp"
 
 namespace c3po {
 
@@ -32,6 +34,22 @@ const char* ToString(CertificatePart part);
 // The weak-motion check replaces the local part when it ran; the global
 // search runs only when everything else passed, so it is then the only part.
 std::vector<CertificatePart> RefusedBy(const Certificate& certificate);
+
+// The names of RefusedBy(estimate.certificate), or {"registration"} when the
+// estimate has no pose (the corrector's registration failed): what `certify`
+// writes as `refused_by`.
+std::vector<std::string> RefusedByNames(const PoseEstimate& estimate);
+
+// Over the processed, uncertified outcomes of a batch, per name in the order
+// "registration", then the parts': how many poses it refused (`failed`; a
+// pose may fail several parts) and how many it refused first (`first`; these
+// sum to the refused poses). Every name is listed, counts may be 0.
+struct RefusalCount {
+  std::string name;
+  int failed = 0;
+  int first = 0;
+};
+std::vector<RefusalCount> CountRefusals(const std::vector<CloudOutcome>& outcomes);
 
 // "" when certified, else one clause per failed part joined by "; ", each
 // with its evidence (object units), e.g. "nd_global: a pose 0.032 away

@@ -20,6 +20,7 @@
 // window.c3poReport = {views (count), webgl (bool), shown (index), show(i),
 // frames (renders so far), orbit ({theta, phi, distance}), measure (set true
 // to make each render count into `coloured` the non-background pixels)}.
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -55,6 +56,8 @@ struct ReportView {
   double adds = 0.0;
   double rotation_error = 0.0;  // radians
   double oc_distance = 0.0;
+  // Hausdorff(T*·B̂, T̂·B̂) when known (eval: certified samples; certify: sources with a truth), else NaN.
+  double truth_hausdorff = std::numeric_limits<double>::quiet_NaN();
   PointSet input;               // the input cloud (subsampled)
   PointSet outliers;            // its points at >= eps_oc from T̂·B̂ (subsampled)
   PointSet posed_model;         // T̂·B̂ (subsampled)
