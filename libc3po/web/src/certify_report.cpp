@@ -111,12 +111,7 @@ std::vector<ReportView> CertifyReportViews(const ObjectModel& object, const std:
     view.oc_distance = e.certificate.oc.max_point_distance;
     if (outcome.truth_hausdorff) view.truth_hausdorff = *outcome.truth_hausdorff;
     view.input = StridedColumns(cloud, options.max_points);
-    PointSet outliers(3, static_cast<Eigen::Index>(e.certificate.oc.outlier_indices.size()));
-    Eigen::Index kept = 0;
-    for (int j : e.certificate.oc.outlier_indices) {
-      if (j >= 0 && j < cloud.cols()) outliers.col(kept++) = cloud.col(j);
-    }
-    view.outliers = StridedColumns(outliers.leftCols(kept), options.max_points);
+    view.outliers = web::OutlierPoints(cloud, e.certificate.oc.outlier_indices, options.max_points);
     view.posed_model = e.scene_from_model * model;
     if (source.scene_from_model_truth) view.truth_model = *source.scene_from_model_truth * model;
     view.keypoints = e.keypoints;

@@ -359,12 +359,7 @@ std::vector<ReportView> SelectReportViews(const ObjectModel& object, const Datas
       view.rotation_error = s->rotation_error;
       view.oc_distance = s->oc_distance;
       view.input = StridedColumns(cloud, options.max_points);
-      PointSet outliers(3, static_cast<Eigen::Index>(s->outlier_indices.size()));
-      Eigen::Index kept = 0;
-      for (int j : s->outlier_indices) {
-        if (j >= 0 && j < cloud.cols()) outliers.col(kept++) = cloud.col(j);
-      }
-      view.outliers = StridedColumns(outliers.leftCols(kept), options.max_points);
+      view.outliers = web::OutlierPoints(cloud, s->outlier_indices, options.max_points);
       const PointSet model = StridedColumns(object.sample(), options.max_points);
       view.posed_model = s->scene_from_model * model;
       const auto& truth = dataset.entries[s->index].pose;

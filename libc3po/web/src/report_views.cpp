@@ -32,6 +32,15 @@ json ViewJson(const ReportView& v) {
 
 }  // namespace
 
+PointSet OutlierPoints(const PointSet& cloud, const std::vector<int>& indices, int max_points) {
+  PointSet outliers(3, static_cast<Eigen::Index>(indices.size()));
+  Eigen::Index kept = 0;
+  for (int j : indices) {
+    if (j >= 0 && j < cloud.cols()) outliers.col(kept++) = cloud.col(j);
+  }
+  return StridedColumns(outliers.leftCols(kept), max_points);
+}
+
 std::string ReportPageStart(const std::string& title) {
   std::ostringstream page;
   page << "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"

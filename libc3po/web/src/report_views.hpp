@@ -9,6 +9,10 @@
 
 namespace c3po::web {
 
+// The columns `indices` of `cloud` (indices outside it are dropped: a stale
+// result is not read), subsampled to `max_points`: an example's outliers.
+PointSet OutlierPoints(const PointSet& cloud, const std::vector<int>& indices, int max_points);
+
 // "<!doctype html> ... <body>" with `title` and the report stylesheet.
 std::string ReportPageStart(const std::string& title);
 // The "Examples in 3D" section: example buttons, layer toggles, the view.
