@@ -89,7 +89,8 @@ std::string Settings(const CertificateOptions& certificate, const CertifyBatchOp
 std::string RefusalTally(const CertifyBatchResult& result) {
   std::string tally;
   for (const RefusalCount& count : CountRefusals(result.outcomes)) {
-    if (count.failed > 0) tally += (tally.empty() ? "; refused by " : ", ") + count.name + " " + std::to_string(count.failed);
+    if (count.failed == 0) continue;
+    tally += (tally.empty() ? "; refused by " : ", ") + count.name + " " + std::to_string(count.failed);
   }
   return tally;
 }
@@ -363,7 +364,8 @@ RunFunction SetupCertify(CLI::App& command) {
                      "with --poses one row per instance: its chosen hypothesis, else its best fit");
   AddShardOption(command, &cmd->shard, "clouds (by image for --bop, by cloud or manifest line otherwise)");
   AddReportOptions(command, &cmd->report,
-                   "poses certified and refused by each certificate part, 3D examples with the reason and the rival pose");
+                   "poses certified and refused by each certificate part, 3D examples with the reason and the "
+                   "rival pose");
   return [cmd]() { return Run(*cmd); };
 }
 

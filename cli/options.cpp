@@ -313,7 +313,8 @@ void ReportFlags::Check() const {
 
 void AddReportOptions(CLI::App& command, ReportFlags* flags, const std::string& contents) {
   command.add_option("--report", flags->path, "Write a self-contained HTML report: " + contents);
-  command.add_option("--views", flags->views, "3D examples in the report: this many certified and rejected (default 3)");
+  command.add_option("--views", flags->views,
+                     "3D examples in the report: this many certified and rejected (default 3)");
 }
 
 void AddShardOption(CLI::App& command, std::string* shard, const std::string& what) {

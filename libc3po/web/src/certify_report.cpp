@@ -51,7 +51,7 @@ std::string CountsHtml(const CertifyReportInput& input) {
     if (count.failed == 0) continue;
     BarRow(out, "refused by " + count.name, count.first, std::to_string(count.failed), total, "#d04040");
   }
-  if (result.errors > 0) BarRow(out, "error (input not read)", result.errors, "-", total, "#888");
+  if (result.errors > 0) BarRow(out, "error (unreadable input or detector failure)", result.errors, "-", total, "#888");
   out << "</tbody>\n</table>\n<p class=\"settings\">" << HtmlEscape(input.settings) << "</p>\n</section>\n";
   return out.str();
 }

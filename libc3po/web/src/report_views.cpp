@@ -20,14 +20,23 @@ json JsonNumber(double value) { return std::isfinite(value) ? json(value) : json
 
 // One example's data: little-endian float32 xyz, base64; unknown numbers null.
 json ViewJson(const ReportView& v) {
-  return {{"title", v.title}, {"cloud", v.cloud}, {"row", v.row}, {"certified", v.certified},
-          {"false_certificate", v.false_certificate}, {"adds", JsonNumber(v.adds)},
+  return {{"title", v.title},
+          {"cloud", v.cloud},
+          {"row", v.row},
+          {"certified", v.certified},
+          {"false_certificate", v.false_certificate},
+          {"adds", JsonNumber(v.adds)},
           {"rotation_error_deg", JsonNumber(v.rotation_error * kDegrees)},
-          {"oc_distance", JsonNumber(v.oc_distance)}, {"input", PointsFloat32Base64(v.input)},
+          {"oc_distance", JsonNumber(v.oc_distance)},
+          {"input", PointsFloat32Base64(v.input)},
           {"outliers", PointsFloat32Base64(v.outliers)},
-          {"posed_model", PointsFloat32Base64(v.posed_model)}, {"truth_model", PointsFloat32Base64(v.truth_model)},
-          {"refusal", v.refusal}, {"truth_hausdorff", JsonNumber(v.truth_hausdorff)}, {"rival_model", PointsFloat32Base64(v.rival_model)},
-          {"keypoints", PointsFloat32Base64(v.keypoints)}, {"detected_keypoints", PointsFloat32Base64(v.detected_keypoints)}};
+          {"posed_model", PointsFloat32Base64(v.posed_model)},
+          {"truth_model", PointsFloat32Base64(v.truth_model)},
+          {"refusal", v.refusal},
+          {"truth_hausdorff", JsonNumber(v.truth_hausdorff)},
+          {"rival_model", PointsFloat32Base64(v.rival_model)},
+          {"keypoints", PointsFloat32Base64(v.keypoints)},
+          {"detected_keypoints", PointsFloat32Base64(v.detected_keypoints)}};
 }
 
 }  // namespace

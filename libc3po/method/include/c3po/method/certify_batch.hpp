@@ -140,7 +140,8 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   cloud, R (3 rows), t, keypoints (N x 3, corrected), oc, nd, certified,
 //   refused_by (the failed parts, refusal.hpp: "oc", "oc_keypoints",
 //   "free_space", "support", "nd_sets", "nd_local", "nd_weak_motion",
-//   "nd_global"; [] when certified, ["registration"] without a pose), oc_distance (null when not finite), keypoint_distance, nd_set,
+//   "nd_global"; [] when certified, ["registration"] without a pose),
+//   oc_distance (null when not finite), keypoint_distance, nd_set,
 //   nd_set_distances, eps_oc, delta_nd, iterations, cost_before, cost_after
 //   (null when not finite), status (registration), restarts_tried,
 //   restart_axis and restart_angle_deg (re-estimation: axis -1 when the
