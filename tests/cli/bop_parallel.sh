@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # Sharded certification of the real YCB-Video frames (issue 15): GNU parallel
 # runs --shard K/3 parts, `c3po merge` joins them, and the result equals the
 # unsharded run (up to the timing fields "ms" and the CSV's time); the Slurm

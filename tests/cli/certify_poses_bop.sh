@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # c3po certify --poses on BOP sources: the BOP CSV that `certify --bop
 # --bop-csv` wrote, certified again with --no-correct, gives every instance
 # the verdict of the first run, on a synth --format bop scene set with two

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # The README's demo in its --quick form: every step runs and writes its outputs
 # (sim data, models, depth data, table, JSON, HTML report).
 # Usage: demo_quick.sh C3PO_BIN SOURCE_DIR WORK_DIR

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # eval --shard K/N + c3po merge --eval (issue 15): the parts' per-sample rows
 # (--samples), run by GNU parallel and merged, give the unsharded eval table
 # byte for byte and its --json document up to the timings "ms"; on --data (a

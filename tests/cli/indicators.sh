@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # c3po indicators end to end: listing, editing with validation (bad input =>
 # exit 2 and the file untouched), in-place writes with a backup, --coverage on
 # a rendered dataset (handle sets fail on handle-less views), --auto with

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # The options certify, eval, selftrain and bench corrector share (cli/options.*)
 # are declared once: the same flags in every --help, help text free of code,
 # repeatable --detector/--model/--plugin taking one value each (so the object

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # Interrupted work loses nothing (issue 7): `train` killed with SIGINT and
 # `selftrain` killed with SIGTERM mid-epoch keep their checkpoint, leave no
 # partial model file, and `--resume` gives the same model bytes as an

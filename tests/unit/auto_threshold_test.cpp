@@ -128,7 +128,7 @@ TEST_CASE("the automatic eps_oc certifies noise-free sampled clouds at their tru
   }
 }
 
-TEST_CASE("oc distances: a cluster above the geometric value raises eps_oc, capped; outliers do not") {
+TEST_CASE("oc distances: a cluster above the geometric value raises eps_oc, capped, outliers do not") {
   const ObjectModel block = Block(5000);
   const std::vector<PointSet> clouds = {NoisyPlane(1500, 0.001, 3)};
   const AutoEpsOcResult base = EstimateEpsOc(block, clouds, {});

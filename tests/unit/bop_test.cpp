@@ -170,7 +170,7 @@ TEST_CASE("listing a scene and a split: ids, masks, ground truth (float32 R proj
   CHECK(drill.DistancesToPosedModel(segment.cloud, split.poses[3][0]).maxCoeff() < 0.005);
 }
 
-TEST_CASE("targets restrict images; detections give RLE masks identical to the files") {
+TEST_CASE("targets restrict images, detections give RLE masks identical to the files") {
   Split& split = SharedSplit();
   c3po::test::TempDir dir("bop_detections");
   c3po::WriteFileAtomically(dir / "targets.json",
@@ -411,7 +411,7 @@ TEST_CASE("--shard K/N on --bop: parts merged with c3po merge equal the unsharde
   }
 }
 
-TEST_CASE("an instance with an empty mask is an error line; the others go on") {
+TEST_CASE("an instance with an empty mask is an error line, the others go on") {
   c3po::test::TempDir dir("bop_empty_mask");
   WriteScene(dir / "000001", 2, 1.0, 31);
   c3po::WritePng(dir / "000001/mask_visib/000001_000000.png", c3po::Image(640, 480, 8));

@@ -151,7 +151,7 @@ TEST_CASE("back-projection of a rendered object equals the renderer's own points
   }
 }
 
-TEST_CASE("masks: non-zero and label images; sizes must match the depth") {
+TEST_CASE("masks: non-zero and label images, sizes must match the depth") {
   c3po::Image label(4, 3, 8);
   label.pixels = {0, 1, 2, 2, 5, 0, 2, 1, 0, 0, 7, 2};
   CHECK(c3po::MaskFromImage(label).Count() == 8);
@@ -361,7 +361,7 @@ TEST_CASE("support plane: the table under a ball is found, the mask's bleed onto
   CHECK(kept_all.cloud.cols() == static_cast<Eigen::Index>(scene.mask.Count()));
 }
 
-TEST_CASE("support plane: the object's own large face is not the support; no dominant plane, nothing dropped") {
+TEST_CASE("support plane: the object's own large face is not the support, no dominant plane, nothing dropped") {
   const int w = 320, h = 240;
   const double distance = 0.01;
   // A frontal box face at 0.6 m covering 56 % of the image, in front of the
@@ -488,7 +488,7 @@ TEST_CASE("malformed RLE is an InputError naming the file") {
   CHECK(ErrorOf([] { c3po::DecodeRle(0, 4, {}, "d.json"); }).find("d.json: malformed RLE: bad size") == 0);
 }
 
-TEST_CASE("camera JSON: cam_K, BOP camera.json, one-entry scene_camera.json, --intrinsics; errors") {
+TEST_CASE("camera JSON: cam_K, BOP camera.json, one-entry scene_camera.json, --intrinsics, errors") {
   const auto k = c3po::ParseCameraJson(R"({"cam_K": [600, 0, 320.5, 0, 610, 240, 0, 0, 1], "depth_scale": 0.1})", "c.json");
   CHECK(k.K.fx == 600);
   CHECK(k.K.fy == 610);
@@ -569,7 +569,7 @@ TEST_CASE(".npy depth: C and Fortran order, float64, strict header and size") {
   CHECK(ErrorOf([&] { c3po::ParseNpyDepth(c3po::EncodeNpyDepth(negative), "d.npy"); }) == "d.npy: negative or infinite depth in .npy");
 }
 
-TEST_CASE("depth PNG: value x depth_scale = mm, converted to metres; 8-bit depth refused") {
+TEST_CASE("depth PNG: value x depth_scale = mm, converted to metres, 8-bit depth refused") {
   c3po::test::TempDir dir("depth_png");
   c3po::Image png(2, 1, 16);
   png.pixels = {1000, 65535};

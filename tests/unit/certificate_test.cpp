@@ -147,7 +147,7 @@ TEST_CASE("non-degeneracy: removing the handle's points flips nd") {
   CHECK(nd.keypoint_distances(0) > options.delta_nd);
 }
 
-TEST_CASE("no indicator sets means nd = 1; empty cloud fails both") {
+TEST_CASE("no indicator sets means nd = 1, empty cloud fails both") {
   const ObjectModel object = test::AsymmetricObject();
   const CertificateOptions options = CertificateOptions::FromObject(object.spec());
   CHECK(CheckNonDegeneracy(object, object.sample(), Pose(), options).passed);

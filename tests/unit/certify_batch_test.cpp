@@ -132,7 +132,7 @@ TEST_CASE("CertifyBatch with given keypoints equals EstimateAndCertify cloud by 
   }
 }
 
-TEST_CASE("CertifyBatch: also_uncorrected certifies T(y~) as well; the visitor sees every processed cloud") {
+TEST_CASE("CertifyBatch: also_uncorrected certifies T(y~) as well, the visitor sees every processed cloud") {
   const Fixture f;
   CertifyBatchOptions options = f.Options(true);
   options.also_uncorrected = true;
@@ -265,7 +265,7 @@ TEST_CASE("--eps-oc auto: eps_oc from the clouds and the oc distances, every oc 
   CHECK(result.oc == again.oc);
 }
 
-TEST_CASE("--eps-oc auto with a budget m: the m farthest points never set eps_oc; oc_m and nd_m decided again") {
+TEST_CASE("--eps-oc auto with a budget m: the m farthest points never set eps_oc, oc_m and nd_m decided again") {
   const Fixture f;
   constexpr int kStray = 3;
   // Every cloud gets kStray points moved one diameter away (stray pixels).

@@ -210,7 +210,7 @@ TEST_CASE("DatasetWriter: parallel producers, sorted manifest, exact round trip"
   }
 }
 
-TEST_CASE("DatasetWriter: abandoned writer leaves nothing; commit replaces an old dataset") {
+TEST_CASE("DatasetWriter: abandoned writer leaves nothing, commit replaces an old dataset") {
   c3po::test::TempDir dir("dataset_replace");
   const std::string target = dir / "ds";
   c3po::Rng rng(15);
@@ -312,7 +312,7 @@ TEST_CASE("DatasetWriter into an unwritable place gives InputError and no output
   MESSAGE("unwritable folder simulated with a path under a regular file: " << message);
 }
 
-TEST_CASE("float32 / few-digit rotations (within 1e-4) are projected; certify-style reading skips ground truth") {
+TEST_CASE("float32 / few-digit rotations (within 1e-4) are projected, certify-style reading skips ground truth") {
   c3po::Rng rng(31);
   const Eigen::Matrix3d R = rng.Rotation();
   std::string rows;

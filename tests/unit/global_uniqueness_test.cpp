@@ -103,7 +103,7 @@ TEST_CASE("global uniqueness: hypotheses and axis rotations") {
   }
 }
 
-TEST_CASE("global uniqueness: a planted two-fold rival is refused; the discriminating part is certified") {
+TEST_CASE("global uniqueness: a planted two-fold rival is refused, the discriminating part is certified") {
   const ObjectModel object = BumpedBox();
   const Pose truth = TestPose();
   const PipelineOptions options = Options(object);

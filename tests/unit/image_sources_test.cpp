@@ -56,7 +56,7 @@ std::vector<CloudSource> Sources(const std::vector<PointSet>& clouds, const std:
 
 }  // namespace
 
-TEST_CASE("segment sources: CertifyBatch equals EstimateAndCertify; counts and ids in the JSON line") {
+TEST_CASE("segment sources: CertifyBatch equals EstimateAndCertify, counts and ids in the JSON line") {
   const ObjectModel object = test::EvaluationObject();
   const std::vector<Pose> poses = test::EvaluationPoses(kClouds);
   std::vector<PointSet> clouds, detected;
@@ -131,7 +131,7 @@ TEST_CASE("segment sources: CertifyBatch equals EstimateAndCertify; counts and i
   }
 }
 
-TEST_CASE("ShardSources: parts 1..N concatenate to the list; an image's instances stay in one part") {
+TEST_CASE("ShardSources: parts 1..N concatenate to the list, an image's instances stay in one part") {
   std::vector<CloudSource> sources;
   // Images of 1-3 instances, with plain sources (groups of their own) between.
   for (int image = 0; image < 7; ++image) {

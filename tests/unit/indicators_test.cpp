@@ -144,7 +144,7 @@ TEST_CASE("LearnIndicatorSets recovers a planted rule and its picks match brute 
   CHECK(learned.accepted_per_set[0] == best);
 }
 
-TEST_CASE("LearnIndicatorSets: no degenerate view means no sets; unreachable views stay rejected") {
+TEST_CASE("LearnIndicatorSets: no degenerate view means no sets, unreachable views stay rejected") {
   std::vector<LabelledView> views = {{0b01, false}, {0b10, false}};
   const LearnedSets none_needed = LearnIndicatorSets(views, 2, {});
   CHECK(none_needed.accept_all);
@@ -420,7 +420,8 @@ TEST_CASE("indicators --auto with deliberate views: independent face-on box view
   CHECK(evidence["deliberate_false_accepts"].get<int>() == 0);
 }
 
-TEST_CASE("indicators --auto: the near margin keeps the face-on guarantee across re-rendered training views") {
+TEST_CASE("indicators --auto: the near margin keeps the face-on guarantee across re-rendered training views"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   // Other training seeds render every view with another noise draw and
   // sampling. A degenerate view blocks the candidates whose keypoints all lie
   // within near_factor * delta_nd of it; with near_factor = 1 (only the

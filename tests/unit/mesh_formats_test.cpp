@@ -315,7 +315,8 @@ TEST_CASE("every own format and variant loads random polygons to their exact are
       {"SOUP_UPPER.OBJ", ObjText(soup)},
   };
   for (const auto& [name, bytes] : files) {
-    CAPTURE(name);
+    const std::string& file_name = name;  // CAPTURE's lambda may not name a structured binding (C++17)
+    CAPTURE(file_name);
     WriteBytes(dir / name, bytes);
     const Mesh mesh = c3po::LoadMesh(dir / name);
     CheckMatchesSoup(mesh, soup);
@@ -503,7 +504,8 @@ TEST_CASE("every truncation and every early-byte corruption of a mesh file is re
   };
   const char replacements[] = {'\0', '\n', ' ', 'x', '1', '.', '-', '/', '\xff'};
   for (const auto& [name, file] : files) {
-    CAPTURE(name);
+    const std::string& file_name = name;  // CAPTURE's lambda may not name a structured binding (C++17)
+    CAPTURE(file_name);
     const std::string path = dir / name;
     REQUIRE(LoadsOrInputError(path, file));
     for (std::size_t cut = 0; cut < file.size(); cut += 1 + cut / 64) LoadsOrInputError(path, file.substr(0, cut));

@@ -187,7 +187,8 @@ TEST_CASE("every mesh format loads to the same box") {
       {"box_binary.stl", BoxStlBinary()},
   };
   for (const auto& [name, contents] : files) {
-    CAPTURE(name);
+    const std::string& file_name = name;  // CAPTURE's lambda may not name a structured binding (C++17)
+    CAPTURE(file_name);
     WriteText(dir / name, contents);
     CheckIsBox(c3po::LoadMesh(dir / name), 1.0);
     CheckIsBox(c3po::LoadMesh(dir / name, 0.001), 0.001);  // a mesh in millimetres

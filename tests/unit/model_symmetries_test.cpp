@@ -132,7 +132,7 @@ TEST_CASE("a 64-sided cylinder: its rotations about the axis are symmetries") {
   CHECK(quarter);
 }
 
-TEST_CASE("an asymmetric object has no symmetry; an absurd tolerance admits the candidates") {
+TEST_CASE("an asymmetric object has no symmetry, an absurd tolerance admits the candidates") {
   const ObjectModel object = test::AsymmetricObject();
   CHECK(FindModelSymmetries(object, Tolerance(0.005)).empty());
   CHECK(FindModelSymmetries(object, Tolerance(10.0)).size() > 20);

@@ -111,7 +111,8 @@ TEST_CASE("mesh units scale the mesh into metres") {
   c3po::test::TempDir dir("object_io_units");
   const c3po::Mesh cube = c3po::LoadMesh(Fixture("cube.obj"));
   for (const auto& [units, side] : std::vector<std::pair<std::string, double>>{{"m", 1.0}, {"cm", 100.0}, {"mm", 1000.0}}) {
-    CAPTURE(units);
+    const std::string& unit_name = units;  // CAPTURE's lambda may not name a structured binding (C++17)
+    CAPTURE(unit_name);
     c3po::Mesh scaled = cube;
     scaled.vertices *= side;
     c3po::WriteObj(scaled, dir / ("cube_" + units + ".obj"));
@@ -214,7 +215,8 @@ TEST_CASE("the CLI turns malformed object and mesh files into exit status 2 and 
       {"annotate " + dir / "missing.obj" + " --keypoint 0,0,0 -o " + dir / "out.json", dir / "missing.obj", ""},
   };
   for (const auto& [args, file, field] : cases) {
-    CAPTURE(args);
+    const std::string& command = args;  // CAPTURE's lambda may not name a structured binding (C++17)
+    CAPTURE(command);
     const auto result = c3po::test::RunC3po(args);
     CAPTURE(result.output);
     CHECK(result.status == 2);

@@ -176,7 +176,7 @@ TEST_CASE("LoadPlugin rejects what is not a c3po plugin, naming the file") {
   }
 }
 
-TEST_CASE("pca is the training-free detector's name; svd stays an alias of it") {
+TEST_CASE("pca is the training-free detector's name, svd stays an alias of it") {
   const std::vector<DetectorInfo> infos = ListDetectors();
   REQUIRE(FindInfo(infos, "pca") != nullptr);
   REQUIRE(FindInfo(infos, "svd") != nullptr);

@@ -178,7 +178,7 @@ TEST_CASE("1-, 2- and 4-bit greyscale read as 8-bit with their stored values") {
   }
 }
 
-TEST_CASE("WritePng/ReadPng through a file; ReadDepthPng wants 16 bits") {
+TEST_CASE("WritePng/ReadPng through a file, ReadDepthPng wants 16 bits") {
   c3po::test::TempDir dir("png_io");
   const c3po::Image depth = RandomImage(40, 30, 16, 9);
   c3po::WritePng(dir / "depth.png", depth);

@@ -152,7 +152,9 @@ TEST_CASE("RotationUpTo draws angles uniformly in [0, max]") {
 
 TEST_CASE("ParallelFor runs every index exactly once") {
   for (int threads : {0, 1, 2, 3, 8, 1000}) {
-    for (const auto& [begin, end] : std::vector<std::pair<int, int>>{{0, 0}, {5, 3}, {0, 1}, {-7, 10}, {3, 5003}}) {
+    for (const auto& range : std::vector<std::pair<int, int>>{{0, 0}, {5, 3}, {0, 1}, {-7, 10}, {3, 5003}}) {
+      const int begin = range.first;  // named, not bound: lambdas may not capture structured bindings in C++17
+      const int end = range.second;
       CAPTURE(threads);
       CAPTURE(begin);
       const int count = std::max(0, end - begin);
@@ -173,7 +175,7 @@ TEST_CASE("ParallelFor runs every index exactly once") {
   }
 }
 
-TEST_CASE("ParallelFor propagates the first exception; each index runs at most once") {
+TEST_CASE("ParallelFor propagates the first exception, each index runs at most once") {
   for (int threads : {1, 2, 4}) {
     CAPTURE(threads);
     std::vector<std::atomic<int>> hits(100000);

@@ -73,7 +73,8 @@ TEST_CASE("rendered points lie on the posed mesh and nothing occludes them") {
   c3po::DepthRenderer renderer(c3po::CameraIntrinsics{});
   c3po::Rng rng(11);
   for (const auto& [name, mesh] : meshes) {
-    CAPTURE(name);
+    const std::string& mesh_name = name;  // CAPTURE's lambda may not name a structured binding (C++17)
+    CAPTURE(mesh_name);
     const double d = mesh.Diameter();
     for (int view = 0; view < 3; ++view) {
       const c3po::Pose pose = PoseAtDistance(rng, mesh, 2.5 * d);
@@ -177,7 +178,7 @@ TEST_CASE("keypoints outside the image or behind the camera are not visible") {
   CHECK_FALSE(visible[2]);
 }
 
-TEST_CASE("re-rendering clears the previous view; empty views are empty") {
+TEST_CASE("re-rendering clears the previous view, empty views are empty") {
   const c3po::BundledObject drill = c3po::MakeBundledObject("drill");
   const double d = drill.mesh.Diameter();
   c3po::Rng rng(9);

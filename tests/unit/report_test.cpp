@@ -454,7 +454,7 @@ TEST_CASE("certify report: each example is its source's cloud with the estimate'
   CHECK_THROWS_AS(CertifyReportHtml(CertifyReportInput{}), std::invalid_argument);
 }
 
-TEST_CASE("training logs are read (numeric fields) and plotted; malformed lines are input errors") {
+TEST_CASE("training logs are read (numeric fields) and plotted, malformed lines are input errors") {
   TempDir dir("report_test_logs");
   {
     std::ofstream log(dir / "sim.model.log.jsonl");

@@ -455,7 +455,7 @@ Scene RenderScene(const ObjectModel& object, std::uint64_t seed, double noise, i
 
 }  // namespace
 
-TEST_CASE("robust corrector: no outliers = today's result; k <= budget outliers cost little") {
+TEST_CASE("robust corrector: no outliers = today's result, k <= budget outliers cost little") {
   const ObjectModel object = test::AsymmetricObject(8000);
   const double d = object.diameter();
   int trials = 0;

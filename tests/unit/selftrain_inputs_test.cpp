@@ -221,7 +221,8 @@ class RecordingOffsetDetector : public TrainableDetector {
 
 }  // namespace
 
-TEST_CASE("self-training splits by group: whole groups are trained on, at least one is held out") {
+TEST_CASE("self-training splits by group: whole groups are trained on and at least one is held out"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel object = test::AsymmetricObject(8000);
   // 10 images of 1-4 instances; every cloud a full, exactly detectable view.
   std::vector<PointSet> clouds;
@@ -341,7 +342,8 @@ TEST_CASE("LabelWithTruth: each cloud's label is the object's keypoints posed at
   CHECK_THROWS_WITH_AS(LabelWithTruth(clouds, object, "c3po train"), doctest::Contains("cloud2"), InputError);
 }
 
-TEST_CASE("mixed camera inputs: another object's augmented instances are never pseudo-labels") {
+TEST_CASE("mixed camera inputs: another object's augmented instances are never pseudo-labels"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel object = test::AsymmetricObject(8000);
   // Images with one instance of the object (obj_id 1) and one of a 12 cm cube
   // (obj_id 2), as segment sources; the detector claims the object in both.

@@ -91,7 +91,8 @@ PointSet CentredKeypoints(const ObjectModel& object) {
 
 }  // namespace
 
-TEST_CASE("self-training raises the certified fraction of a biased detector") {
+TEST_CASE("self-training raises the certified fraction of a biased detector"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel object = test::AsymmetricObject(20000);
   const auto clouds = Clouds(object, 40);
   // Biased start: every keypoint shifted by 3 cm; the corrector can still fix
@@ -184,7 +185,8 @@ TEST_CASE("self-training with nothing certified stops with a clear message") {
                        doctest::Contains("nothing to learn from"), InputError);
 }
 
-TEST_CASE("resuming from a checkpoint gives the uninterrupted result") {
+TEST_CASE("resuming from a checkpoint gives the uninterrupted result"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel object = test::AsymmetricObject(8000);
   const auto clouds = Clouds(object, 24);
   const PointSet start = CentredKeypoints(object).colwise() + Eigen::Vector3d(0.02, 0.0, 0.01);
@@ -408,7 +410,8 @@ TEST_CASE("pseudo-label check: a second basin the frame refutes is no second exp
   }
 }
 
-TEST_CASE("self-training on a flat near-symmetric object: the flip is learnt without the ambiguity rule, refused with it") {
+TEST_CASE("self-training on a flat near-symmetric object: the flip is learnt without the ambiguity rule and refused with it"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel object = FlatNearSymmetricObject(0.004);
   std::vector<Pose> truth;
   const auto clouds = NoisyClouds(object, 32, 0.0005, 5, &truth);
@@ -456,7 +459,8 @@ TEST_CASE("self-training on a flat near-symmetric object: the flip is learnt wit
   CHECK((after - correct).norm() < (after - flipped).norm());
 }
 
-TEST_CASE("symmetric labellings: an exactly symmetric slab's flips are labellings, trained with the min loss") {
+TEST_CASE("symmetric labellings: an exactly symmetric slab's flips are labellings and are trained with the min loss"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   // The slab without its bump is mapped onto itself by the half-turns about
   // its three axes: each flip places the same shape with other keypoints.
   // Oracle: the exact half-turn about the slab's normal through its centre.
@@ -560,7 +564,8 @@ TEST_CASE("symmetric labellings: an exactly symmetric slab's flips are labelling
   }
 }
 
-TEST_CASE("self-training keeps the correct mode when the certificate separates the flip") {
+TEST_CASE("self-training keeps the correct mode when the certificate separates the flip"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   // A 2.5 cm bump: the flipped slab leaves points 2.5 cm from the model, so
   // the flip fails the 1 cm certificate and the samples are not ambiguous.
   const ObjectModel object = FlatNearSymmetricObject(0.025);
@@ -577,7 +582,8 @@ TEST_CASE("self-training keeps the correct mode when the certificate separates t
   CHECK((after - CentredKeypoints(object)).norm() < (TurnedKeypoints(object, 20.0) - CentredKeypoints(object)).norm());
 }
 
-TEST_CASE("epoch selection rolls back a deliberately bad epoch") {
+TEST_CASE("epoch selection rolls back a deliberately bad epoch"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel object = test::AsymmetricObject(8000);
   const auto clouds = Clouds(object, 40);
   SelfTrainOptions options = Options(object);
@@ -620,7 +626,8 @@ TEST_CASE("patience stops self-training after epochs without a new best") {
   CHECK(result.best_epoch == 0);
 }
 
-TEST_CASE("mixed unlabelled data: another object's clouds are never pseudo-labels") {
+TEST_CASE("mixed unlabelled data: another object's clouds are never pseudo-labels"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel object = test::AsymmetricObject(8000);
   // A 12 cm cube: no pose of the asymmetric object explains its clouds
   // within eps_oc, so the certificate must reject every one of them.
@@ -694,7 +701,8 @@ TEST_CASE("epoch criterion: the validation measures the detector, not re-estimat
   CHECK(fit.residual_q50 == 0.0);
 }
 
-TEST_CASE("epoch selection: a detector that starts with no oc validation cloud can improve") {
+TEST_CASE("epoch selection: a detector that starts with no oc validation cloud can improve"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   // The detector starts in the flipped basin (no validation cloud passes oc,
   // so the start has no residual and no agreement to compare); re-estimation
   // makes its training pseudo-labels. An epoch that identifies validation

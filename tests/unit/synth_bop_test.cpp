@@ -312,7 +312,8 @@ TEST_CASE("synth bop: interruption leaves nothing, impossible options are refuse
   CHECK(fs::is_empty(tmp.path()));
 }
 
-TEST_CASE("synth bop realistic preset: target segments look like real YCB-Video segments") {
+TEST_CASE("synth bop realistic preset: target segments look like real YCB-Video segments"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   // Issue 15 measured, on 240 real YCB-Video instances with the dataset's own
   // masks and poses: the median point lies 0.5-2 mm from the true surface and
   // 0.1-15 % of a segment's points lie more than 5 mm away. The preset should
