@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # c3po certify --poses: the poses c3po itself wrote (certify -o JSON lines)
 # certified again as given poses with --no-correct give the same verdicts;
 # a wrong extra hypothesis per cloud is rejected and never chosen; the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # c3po eval end to end on a small synthetic depth dataset whose manifest holds
 # perturbed keypoints (--detector manifest): table, JSON (summaries agree with
 # the per-sample results recomputed here), ADD-S variants, thresholds, the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # The evaluation and certify reports in headless Chromium (Debian package `chromium`,
 # driven by npm playwright-core, like annotate_browser.sh): loads without
 # console errors or network requests, shows the table and a WebGL 3D view that

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # selftrain on camera inputs and mixed data (issue 18 parts 3-4): --bop with
 # the paper's augmentation (instances x --copies augmented clouds, split by
 # image), one-line errors for bad inputs; merge --prefix-parts makes a mixed

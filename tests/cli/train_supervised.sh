@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# ctest-labels: heavy
 # train on real frames labelled by their ground truth and fine-tuning with
 # --init (issue 18, the "supervised bound"). Oracles, all computed here from
 # the files, not from c3po's training code:

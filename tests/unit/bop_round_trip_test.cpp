@@ -83,7 +83,8 @@ RoundTrip Run(const std::string& object_file, const std::string& dir, const std:
 
 }  // namespace
 
-TEST_CASE("synth --format bop -> certify --bop: certified poses are correct (bundled drill)") {
+TEST_CASE("synth --format bop -> certify --bop: certified poses are correct (bundled drill)"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   c3po::test::TempDir tmp("bop_round_trip");
   const std::string drill = c3po::test::SourceDir() + "/annotations/drill.json";
   // The drill with a box (obj_id 6) as a distractor that may hide part of it.

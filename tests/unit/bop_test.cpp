@@ -425,7 +425,8 @@ TEST_CASE("an instance with an empty mask is an error line, the others go on") {
   CHECK(lines[1].contains("R"));
 }
 
-TEST_CASE("real YCB-Video frames: certify --bop runs and every line carries the ids") {
+TEST_CASE("real YCB-Video frames: certify --bop runs and every line carries the ids"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const std::string root = c3po::test::SharedData() + "/real/ycbv-bop";
   if (!fs::exists(root + "/test")) {
     MESSAGE("skipped: " << root << " is absent");

@@ -64,7 +64,7 @@ TEST_CASE("segment sources: CertifyBatch equals EstimateAndCertify, counts and i
     clouds.push_back(test::EvaluationCloud(object, poses[i], i));
     detected.push_back(test::DetectedKeypoints(object, poses[i], i));
   }
-  clouds[3] = clouds[3].leftCols(2);   // too few points: an error, with its counts
+  clouds[3] = clouds[3].leftCols(2).eval();   // too few points (eval: no aliasing): an error
   std::vector<CloudSource> sources = Sources(clouds, poses);
   for (int i = 0; i < kClouds; ++i) sources[i].given_keypoints = detected[i];
   CertifyBatchOptions options;

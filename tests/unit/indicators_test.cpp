@@ -250,7 +250,8 @@ TEST_CASE("RenderView is deterministic and its directions cover the sphere") {
   CHECK((mean / options.views).norm() < 0.05);
 }
 
-TEST_CASE("LearnIndicatorSetsFromViews on the bundled mug finds the handle") {
+TEST_CASE("LearnIndicatorSetsFromViews on the bundled mug finds the handle"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel mug = LoadObject(test::SourceDir() + "/annotations/mug.json");
   AutoIndicatorOptions options;
   options.training.views = 24;
@@ -397,7 +398,8 @@ AutoIndicatorOptions FewRandomViews(std::uint64_t seed, double near_factor) {
 
 }  // namespace
 
-TEST_CASE("indicators --auto with deliberate views: independent face-on box views are never accepted") {
+TEST_CASE("indicators --auto with deliberate views: independent face-on box views are never accepted"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel box = CornerBox({0.16, 0.08, 0.22});
   const AutoIndicatorResult result = LearnIndicatorSetsFromViews(box, FewRandomViews(1, 2.0));
   CHECK(result.deliberate_trained);

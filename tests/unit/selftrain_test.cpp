@@ -611,7 +611,8 @@ TEST_CASE("epoch selection rolls back a deliberately bad epoch"
   CHECK(final_fit.detection_error < 0.01);
 }
 
-TEST_CASE("patience stops self-training after epochs without a new best") {
+TEST_CASE("patience stops self-training after epochs without a new best"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   const ObjectModel object = test::AsymmetricObject(8000);
   const auto clouds = Clouds(object, 24);
   SelfTrainOptions options = Options(object);
@@ -678,7 +679,8 @@ TEST_CASE("mixed unlabelled data: another object's clouds are never pseudo-label
   CHECK(on_mixed.residual_q90 == on_own.residual_q90);
 }
 
-TEST_CASE("epoch criterion: the validation measures the detector, not re-estimation's rescue") {
+TEST_CASE("epoch criterion: the validation measures the detector and not re-estimation's rescue"
+          * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
   // A 2.5 cm bump: a detector in the flipped basin is refuted by the bump's
   // points, and re-estimation's half-turn restart would certify the truth
   // whatever the detector said. Selection must see the detector as it is.
