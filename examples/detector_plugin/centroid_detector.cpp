@@ -12,6 +12,15 @@
 #include <new>
 #include <vector>
 
+// c3po's own tests build this file three times (tests/targets/test_plugin):
+// as it is, registered under another name, and with a wrong ABI version.
+#ifndef CENTROID_PLUGIN_NAME
+#define CENTROID_PLUGIN_NAME "centroid"
+#endif
+#ifndef CENTROID_PLUGIN_ABI
+#define CENTROID_PLUGIN_ABI C3PO_PLUGIN_ABI_VERSION
+#endif
+
 namespace {
 
 struct CentroidDetector {
@@ -57,8 +66,8 @@ int Detect(void* instance, const double* cloud, int num_points, double* keypoint
 const char* LastError(void* /*instance*/) { return last_error; }
 
 const c3po_detector_plugin kPlugin = {
-    C3PO_PLUGIN_ABI_VERSION,   // checked by c3po when it loads the plugin
-    "centroid",
+    CENTROID_PLUGIN_ABI,   // checked by c3po when it loads the plugin
+    CENTROID_PLUGIN_NAME,
     "example plugin: the model keypoints moved onto the cloud centroid (no rotation)",
     Create, Destroy, Detect, LastError};
 
