@@ -97,8 +97,8 @@ nlohmann::json EpochJson(const SelfTrainEpochLog& e) {
   return j;
 }
 
-int Run(SelftrainCommand cmd) {
-  const ObjectModel object = LoadObject(cmd.object_path);
+// The sim-trained detector with the command's learning rate and optimizer.
+std::unique_ptr<PointNetDetector> LoadDetector(const SelftrainCommand& cmd, const ObjectModel& object) {
   std::unique_ptr<PointNetDetector> detector = PointNetDetector::Load(cmd.model_path, object);
   PointNetTrainOptions train_options = detector->train_options();
   train_options.lr = cmd.lr;
@@ -109,48 +109,149 @@ int Run(SelftrainCommand cmd) {
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what());
   }
-  SelfTrainOptions& options = cmd.options;
-  ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
-  options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
+  return detector;
+}
+
+// The flags bound into cmd->options (corrector, thresholds, the input's
+// robust defaults, symmetry tolerance, checkpoint), checked.
+void ResolveOptions(const ObjectModel& object, SelftrainCommand* cmd) {
+  SelfTrainOptions& options = cmd->options;
+  ResolveCorrector(cmd->corrector, &options.pipeline.corrector);
+  options.pipeline.certificate = ResolveThresholds(cmd->thresholds, object);
   // Camera clouds are certified with their frames (free space), as certify
   // does; with --data as well, the dataset's clouds have none.
-  const InputKind input = !cmd.camera.given()    ? InputKind::kClouds
-                          : cmd.data_dir.empty() ? InputKind::kCameraFrames
-                                                 : InputKind::kCameraSegments;
-  ResolveRobust(cmd.robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
-  if (!cmd.symmetry_tolerance.empty()) {
+  const InputKind input = !cmd->camera.given()    ? InputKind::kClouds
+                          : cmd->data_dir.empty() ? InputKind::kCameraFrames
+                                                  : InputKind::kCameraSegments;
+  ResolveRobust(cmd->robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
+  if (!cmd->symmetry_tolerance.empty()) {
     options.pseudo_labels.symmetry_tolerance =
-        ParseThreshold(cmd.symmetry_tolerance, object.diameter(), "--symmetry-tolerance");
+        ParseThreshold(cmd->symmetry_tolerance, object.diameter(), "--symmetry-tolerance");
   }
-  options.checkpoint_path = cmd.output_path + ".ckpt";
+  options.checkpoint_path = cmd->output_path + ".ckpt";
   try {
     options.Check();
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what());
   }
-  if (cmd.resume && !std::filesystem::exists(options.checkpoint_path)) {
+  if (cmd->resume && !std::filesystem::exists(options.checkpoint_path)) {
     throw InputError(options.checkpoint_path, "no checkpoint to resume from");
   }
+}
+
+// The object's symmetries: labellings T̂·S·b of every certified sample (the
+// symmetry-aware loss) and reported rotation errors to the nearest symmetric
+// truth.
+std::vector<Pose> FindSymmetries(const SelftrainCommand& cmd, const ObjectModel& object) {
+  std::vector<Pose> symmetries;
+  const bool aware = cmd.options.pseudo_labels.symmetry_aware;
+  for (const ModelSymmetry& s : ObjectSymmetries(SymmetryFlags{true, cmd.symmetry_tolerance}, object,
+                                                 aware ? "every certified sample trained on its nearest labelling"
+                                                       : "reported rotation errors only (--no-symmetry-aware-loss)")) {
+    symmetries.push_back(s.model_from_model);
+  }
+  return symmetries;
+}
+
+// Another object's truth is not this object's: a mixed set has no reporting columns.
+bool IsMixed(const UnlabelledClouds& data, const ObjectModel& object) {
+  return std::any_of(data.labels.begin(), data.labels.end(),
+                     [&](const std::string& label) { return !label.empty() && label != object.name(); });
+}
+
+// --eps-oc auto (CertifyBatch decides it): from the unlabelled clouds and the
+// oc distances of the sim-trained detector + corrector on them. Sets the
+// pipeline's eps_oc and returns the evidence (JSON).
+std::string ResolveAutoEpsOc(const ObjectModel& object, const UnlabelledClouds& data, const Detector& detector,
+                             const std::vector<DepthView>* frames, SelfTrainOptions* options) {
+  const CertifiedFraction initial =
+      MeasureCertified(object, data.clouds, detector, options->pipeline, /*auto_eps_oc=*/true, frames);
+  const AutoEpsOcResult& chosen = *initial.auto_eps_oc;
+  options->pipeline.certificate.eps_oc = chosen.eps_oc;
+  std::fprintf(stderr, "c3po selftrain: --eps-oc auto = %.6g (%s; eps_w = %.4g, eps_s = %.4g)\n", chosen.eps_oc,
+               chosen.rule.c_str(), chosen.noise.eps_w, chosen.sampling.eps_s);
+  return chosen.ToJson();
+}
+
+void PrintEpoch(const SelfTrainEpochLog& e) {
+  std::fprintf(stderr, "epoch %3d  train oc %5.1f%% (%d ambiguous skipped, %d symmetric)  val oc %5.1f%%  "
+               "identified %5.1f%%  residual q50 %.3g q90 %.3g  loss %.3e%s%s  %.1fs\n",
+               e.epoch, e.train_percent_oc, e.ambiguous_skipped, e.symmetric_trained, e.validation_percent_oc,
+               e.validation_percent_identified, e.validation_residual_q50, e.validation_residual_q90, e.loss,
+               e.rolled_back ? "  ROLLED BACK" : "",
+               e.validation_hausdorff_median >= 0
+                   ? (" [truth: rot " + std::to_string(e.validation_rotation_error_median) + " deg, hausdorff " +
+                      std::to_string(e.validation_hausdorff_median) + "]").c_str()
+                   : "",
+               e.seconds);
+}
+
+// Once, when most certified samples were ambiguous: how far the second
+// basins are from a symmetry. Returns whether it printed.
+bool PrintAmbiguityHint(const SelfTrainEpochLog& e, const SelfTrainOptions& options) {
+  if (e.ambiguous_surface_q50 < 0 || 2 * e.ambiguous_skipped < e.certified_samples) return false;
+  std::fprintf(stderr, "c3po selftrain: %d of %d certified samples were ambiguous; their second basins lie a "
+               "median %.3g from the chosen pose on the surface (symmetry tolerance %.3g): if the object is "
+               "symmetric within that, --symmetry-tolerance declares it (docs/method.md, \"Symmetric "
+               "labellings\")\n",
+               e.ambiguous_skipped, e.certified_samples, e.ambiguous_surface_q50,
+               options.pseudo_labels.SymmetryTolerance(options.pipeline.certificate.eps_oc));
+  return true;
+}
+
+// The model file's "selftrain" record.
+nlohmann::json SelftrainRecord(const SelftrainCommand& cmd, const SelfTrainResult& result,
+                               const std::string& eps_oc_evidence) {
+  const CertificateOptions& certificate = cmd.options.pipeline.certificate;
+  nlohmann::json record = {{"source_model", std::filesystem::path(cmd.model_path).filename().string()},
+                           {"eps_oc", certificate.eps_oc},
+                           {"delta_nd", certificate.delta_nd},
+                           {"best_epoch", result.best_epoch},
+                           {"initial_validation_percent_oc", result.initial_validation_percent_oc},
+                           {"best_validation_percent_oc", result.best_validation_percent_oc},
+                           {"initial_validation_percent_identified", result.initial.percent_identified},
+                           {"best_validation_percent_identified", result.best.percent_identified},
+                           {"initial_validation_residual_q50", result.initial.residual_q50},
+                           {"best_validation_residual_q50", result.best.residual_q50},
+                           {"stopped_early", result.stopped_early}};
+  if (!eps_oc_evidence.empty()) record["eps_oc_auto"] = nlohmann::json::parse(eps_oc_evidence);
+  return record;
+}
+
+// Per object label of a mixed set: clouds, clouds whose pseudo-label was
+// trained on, training uses (printed, and returned for the model file).
+nlohmann::json PseudoLabelsByObject(const UnlabelledClouds& data, const SelfTrainResult& result,
+                                    const ObjectModel& object) {
+  std::map<std::string, std::array<long, 3>> by_label;
+  for (std::size_t i = 0; i < data.clouds.size(); ++i) {
+    auto& counts = by_label[data.labels[i].empty() ? "(unlabelled)" : data.labels[i]];
+    counts[0] += 1;
+    counts[1] += result.pseudo_label_uses[i] > 0;
+    counts[2] += result.pseudo_label_uses[i];
+  }
+  nlohmann::json table = nlohmann::json::object();
+  for (const auto& [label, counts] : by_label) {
+    table[label] = {{"clouds", counts[0]}, {"trained_on", counts[1]}, {"uses", counts[2]}};
+    std::printf("pseudo-labels from %s clouds%s: %ld of %ld clouds trained on (%ld uses)\n", label.c_str(),
+                label == object.name() ? " (this object)" : "", counts[1], counts[0], counts[2]);
+  }
+  return table;
+}
+
+int Run(SelftrainCommand cmd) {
+  const ObjectModel object = LoadObject(cmd.object_path);
+  std::unique_ptr<PointNetDetector> detector = LoadDetector(cmd, object);
+  ResolveOptions(object, &cmd);
+  SelfTrainOptions& options = cmd.options;
   const UnlabelledClouds data = LoadClouds(cmd, object);
   const std::vector<PointSet>& clouds = data.clouds;
   if (clouds.size() < 2) throw InputError("need at least 2 clouds to self-train");
+  const bool mixed = IsMixed(data, object);
+  const std::vector<Pose> symmetries = FindSymmetries(cmd, object);
+  if (options.pseudo_labels.symmetry_aware) options.pseudo_labels.model_symmetries = symmetries;
   // Ground truth, when every cloud has it, only feeds the log's reporting
   // columns (rotation error, Hausdorff distance); selection never reads it.
   std::optional<SelfTrainReference> reference;
-  // Another object's truth is not this object's: no reporting columns on a mixed set.
-  const bool mixed = std::any_of(data.labels.begin(), data.labels.end(),
-                                 [&](const std::string& label) { return !label.empty() && label != object.name(); });
-  // The object's symmetries: labellings T̂·S·b of every certified sample (the
-  // symmetry-aware loss) and reported rotation errors to the nearest
-  // symmetric truth.
-  std::vector<Pose> symmetries;
-  for (const ModelSymmetry& s : ObjectSymmetries(SymmetryFlags{true, cmd.symmetry_tolerance}, object,
-                                                 options.pseudo_labels.symmetry_aware
-                                                     ? "every certified sample trained on its nearest labelling"
-                                                     : "reported rotation errors only (--no-symmetry-aware-loss)")) {
-    symmetries.push_back(s.model_from_model);
-  }
-  if (options.pseudo_labels.symmetry_aware) options.pseudo_labels.model_symmetries = symmetries;
   if (data.AllHaveTruth() && !mixed) {
     reference.emplace();
     for (const auto& truth : data.truth) reference->scene_from_model.push_back(*truth);
@@ -158,18 +259,8 @@ int Run(SelftrainCommand cmd) {
   }
   // One frame per cloud when camera inputs are among them (free space), else none.
   const std::vector<DepthView>* frames = data.frames.size() == clouds.size() ? &data.frames : nullptr;
-  std::string eps_oc_evidence;
-  if (cmd.thresholds.auto_eps_oc()) {
-    // --eps-oc auto (CertifyBatch decides it): from the unlabelled clouds and
-    // the oc distances of the sim-trained detector + corrector on them.
-    const CertifiedFraction initial =
-        MeasureCertified(object, clouds, *detector, options.pipeline, /*auto_eps_oc=*/true, frames);
-    const AutoEpsOcResult& chosen = *initial.auto_eps_oc;
-    options.pipeline.certificate.eps_oc = chosen.eps_oc;
-    eps_oc_evidence = chosen.ToJson();
-    std::fprintf(stderr, "c3po selftrain: --eps-oc auto = %.6g (%s; eps_w = %.4g, eps_s = %.4g)\n", chosen.eps_oc,
-                 chosen.rule.c_str(), chosen.noise.eps_w, chosen.sampling.eps_s);
-  }
+  const std::string eps_oc_evidence =
+      cmd.thresholds.auto_eps_oc() ? ResolveAutoEpsOc(object, data, *detector, frames, &options) : "";
 
   EpochLogFile log(cmd.output_path);
   if (cmd.resume) log.LoadExisting();
@@ -187,62 +278,15 @@ int Run(SelftrainCommand cmd) {
       [&](const SelfTrainEpochLog& e) {
         progress.Finish();
         log.Record(e.epoch, EpochJson(e).dump());
-        std::fprintf(stderr, "epoch %3d  train oc %5.1f%% (%d ambiguous skipped, %d symmetric)  val oc %5.1f%%  identified %5.1f%%  "
-                     "residual q50 %.3g q90 %.3g  loss %.3e%s%s  %.1fs\n",
-                     e.epoch, e.train_percent_oc, e.ambiguous_skipped, e.symmetric_trained, e.validation_percent_oc,
-                     e.validation_percent_identified, e.validation_residual_q50, e.validation_residual_q90, e.loss,
-                     e.rolled_back ? "  ROLLED BACK" : "",
-                     e.validation_hausdorff_median >= 0
-                         ? (" [truth: rot " + std::to_string(e.validation_rotation_error_median) + " deg, hausdorff " +
-                            std::to_string(e.validation_hausdorff_median) + "]").c_str()
-                         : "",
-                     e.seconds);
-        if (!hinted && e.ambiguous_surface_q50 >= 0 && 2 * e.ambiguous_skipped >= e.certified_samples) {
-          // Mostly ambiguous: say how far the second basins are from a symmetry.
-          hinted = true;
-          std::fprintf(stderr, "c3po selftrain: %d of %d certified samples were ambiguous; their second basins lie a "
-                       "median %.3g from the chosen pose on the surface (symmetry tolerance %.3g): if the object is "
-                       "symmetric within that, --symmetry-tolerance declares it (docs/method.md, \"Symmetric "
-                       "labellings\")\n",
-                       e.ambiguous_skipped, e.certified_samples, e.ambiguous_surface_q50,
-                       options.pseudo_labels.SymmetryTolerance(options.pipeline.certificate.eps_oc));
-        }
+        PrintEpoch(e);
+        hinted = hinted || PrintAmbiguityHint(e, options);
         progress = ProgressBar("selftrain", 1);
       },
       [&](std::size_t done, std::size_t total) { progress.Update(total ? done / total : 0); }, cmd.resume,
       reference ? &*reference : nullptr, &data.groups, frames);
   progress.Finish();
-  nlohmann::json extra = {
-      {"selftrained", true},
-      {"selftrain", {{"source_model", std::filesystem::path(cmd.model_path).filename().string()},
-                     {"eps_oc", options.pipeline.certificate.eps_oc},
-                     {"delta_nd", options.pipeline.certificate.delta_nd},
-                     {"best_epoch", result.best_epoch},
-                     {"initial_validation_percent_oc", result.initial_validation_percent_oc},
-                     {"best_validation_percent_oc", result.best_validation_percent_oc},
-                     {"initial_validation_percent_identified", result.initial.percent_identified},
-                     {"best_validation_percent_identified", result.best.percent_identified},
-                     {"initial_validation_residual_q50", result.initial.residual_q50},
-                     {"best_validation_residual_q50", result.best.residual_q50},
-                     {"stopped_early", result.stopped_early}}}};
-  if (!eps_oc_evidence.empty()) extra["selftrain"]["eps_oc_auto"] = nlohmann::json::parse(eps_oc_evidence);
-  if (mixed) {
-    // Per object label: clouds, clouds whose pseudo-label was trained on, training uses.
-    std::map<std::string, std::array<long, 3>> by_label;
-    for (std::size_t i = 0; i < clouds.size(); ++i) {
-      auto& counts = by_label[data.labels[i].empty() ? "(unlabelled)" : data.labels[i]];
-      counts[0] += 1;
-      counts[1] += result.pseudo_label_uses[i] > 0;
-      counts[2] += result.pseudo_label_uses[i];
-    }
-    nlohmann::json table = nlohmann::json::object();
-    for (const auto& [label, counts] : by_label) {
-      table[label] = {{"clouds", counts[0]}, {"trained_on", counts[1]}, {"uses", counts[2]}};
-      std::printf("pseudo-labels from %s clouds%s: %ld of %ld clouds trained on (%ld uses)\n", label.c_str(),
-                  label == object.name() ? " (this object)" : "", counts[1], counts[0], counts[2]);
-    }
-    extra["selftrain"]["pseudo_labels_by_object"] = table;
-  }
+  nlohmann::json extra = {{"selftrained", true}, {"selftrain", SelftrainRecord(cmd, result, eps_oc_evidence)}};
+  if (mixed) extra["selftrain"]["pseudo_labels_by_object"] = PseudoLabelsByObject(data, result, object);
   detector->Save(cmd.output_path, extra.dump());
   std::printf("wrote %s: validation %% oc %.1f -> %.1f, %% identified %.1f -> %.1f, residual q50 %.3g -> %.3g "
               "(best epoch %d%s); eps_oc = %.6g; log %s\n",

@@ -82,76 +82,89 @@ Dataset ReadLabelled(const std::string& dir, int num_keypoints) {
   return dataset;
 }
 
-int Run(TrainCommand cmd) {
-  if (cmd.detector != "pointnet") {
-    throw InputError("--detector", "'" + cmd.detector + "' is not trainable (trainable: pointnet)");
-  }
-  if (cmd.data_dir.empty() && !cmd.camera.given()) {
-    throw InputError("no labelled clouds given (--data DIR, --bop DIR --obj-id K, or --depth/--mask)");
-  }
-  const ObjectModel object = LoadObject(cmd.object_path);
-  std::unique_ptr<PointNetDetector> detector;
+// The architecture: the --init model's (loaded into *init, fine-tuned and
+// validated before its first epoch) or the flags'; options completed and checked.
+PointNetArchitecture ResolveArchitecture(const ObjectModel& object, TrainCommand* cmd,
+                                         std::unique_ptr<PointNetDetector>* init) {
   PointNetArchitecture architecture;
-  if (!cmd.init_path.empty()) {
-    detector = PointNetDetector::Load(cmd.init_path, object);   // InputError: foreign or corrupt model
-    architecture = detector->architecture();
-    CheckInitArchitecture(cmd, architecture);
-    cmd.options.num_points = architecture.num_points;
-    cmd.options.validate_initial = true;
+  if (!cmd->init_path.empty()) {
+    *init = PointNetDetector::Load(cmd->init_path, object);   // InputError: foreign or corrupt model
+    architecture = (*init)->architecture();
+    CheckInitArchitecture(*cmd, architecture);
+    cmd->options.num_points = architecture.num_points;
+    cmd->options.validate_initial = true;
   } else {
-    architecture.num_points = cmd.options.num_points;
-    architecture.point_mlp = cmd.point_mlp;
-    architecture.head = cmd.head;
+    architecture.num_points = cmd->options.num_points;
+    architecture.point_mlp = cmd->point_mlp;
+    architecture.head = cmd->head;
   }
-  cmd.options.checkpoint_path = cmd.output_path + ".ckpt";
-  cmd.options.resume = cmd.resume;
+  cmd->options.checkpoint_path = cmd->output_path + ".ckpt";
+  cmd->options.resume = cmd->resume;
   try {
     architecture.Check();
-    cmd.options.Check();
+    cmd->options.Check();
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what());
   }
+  return architecture;
+}
+
+struct LabelledSamples {
   std::vector<TrainingSample> train;
+  std::vector<TrainingSample> validation;
+  std::size_t camera_clouds = 0;   // of which from camera inputs (augmented copies included)
+};
+
+// The labelled clouds: a dataset and/or camera inputs labelled by their
+// ground truth (augmented like selftrain's), and the held-out ones: --val-data,
+// or for camera inputs whole images (SplitValidation).
+LabelledSamples LoadLabelled(const ObjectModel& object, TrainCommand* cmd) {
+  LabelledSamples samples;
   std::vector<int> groups;   // validation unit of each sample: a dataset cloud, or an image
-  if (!cmd.data_dir.empty()) {
-    const Dataset dataset = ReadLabelled(cmd.data_dir, object.num_keypoints());
-    train = Samples(dataset, LoadDatasetClouds(dataset, "loading"));
-    for (std::size_t i = 0; i < train.size(); ++i) groups.push_back(static_cast<int>(i));
+  if (!cmd->data_dir.empty()) {
+    const Dataset dataset = ReadLabelled(cmd->data_dir, object.num_keypoints());
+    samples.train = Samples(dataset, LoadDatasetClouds(dataset, "loading"));
+    for (std::size_t i = 0; i < samples.train.size(); ++i) groups.push_back(static_cast<int>(i));
   }
-  // Real frames: labelled by their ground truth, augmented like selftrain's.
   UnlabelledClouds camera =
-      LoadCameraClouds(&cmd.camera, object, cmd.options.seed, "c3po train", /*need_truth=*/true);
+      LoadCameraClouds(&cmd->camera, object, cmd->options.seed, "c3po train", /*need_truth=*/true);
   camera.frames.clear();   // supervised training certifies nothing: the depth images are not kept
-  if (cmd.camera.given() && camera.clouds.empty()) {
-    throw InputError(cmd.camera.bop.dir.empty() ? cmd.camera.frame.mask_path : cmd.camera.bop.dir,
+  if (cmd->camera.given() && camera.clouds.empty()) {
+    throw InputError(cmd->camera.bop.dir.empty() ? cmd->camera.frame.mask_path : cmd->camera.bop.dir,
                      "no instance could be read");
   }
   const int offset = static_cast<int>(groups.size());
-  for (TrainingSample& sample : LabelWithTruth(camera, object, "--bop")) train.push_back(std::move(sample));
+  for (TrainingSample& sample : LabelWithTruth(camera, object, "--bop")) samples.train.push_back(std::move(sample));
   for (int group : camera.groups) groups.push_back(group + offset);
+  samples.camera_clouds = camera.clouds.size();
 
-  std::vector<TrainingSample> validation;
-  if (!cmd.validation_dir.empty()) {
-    const Dataset held_out = ReadLabelled(cmd.validation_dir, object.num_keypoints());
-    validation = Samples(held_out, LoadDatasetClouds(held_out, "loading validation"));
-  } else if (!camera.clouds.empty() && cmd.options.validation_fraction > 0) {
-    // Camera frames: held out by image, as selftrain does (SplitValidation).
+  if (!cmd->validation_dir.empty()) {
+    const Dataset held_out = ReadLabelled(cmd->validation_dir, object.num_keypoints());
+    samples.validation = Samples(held_out, LoadDatasetClouds(held_out, "loading validation"));
+  } else if (!camera.clouds.empty() && cmd->options.validation_fraction > 0) {
+    std::vector<TrainingSample>& train = samples.train;
     if (train.size() < 2) {
       throw InputError("--val-fraction", "need at least 2 labelled clouds to hold some out (or --val-fraction 0)");
     }
     const ValidationSplit split =
-        SplitValidation(train.size(), &groups, cmd.options.validation_fraction, cmd.options.seed, "--val-fraction");
+        SplitValidation(train.size(), &groups, cmd->options.validation_fraction, cmd->options.seed, "--val-fraction");
     std::vector<TrainingSample> kept;
-    for (int i : split.validation) validation.push_back(train[static_cast<std::size_t>(i)]);
+    for (int i : split.validation) samples.validation.push_back(train[static_cast<std::size_t>(i)]);
     for (int i : split.train) kept.push_back(std::move(train[static_cast<std::size_t>(i)]));
     train = std::move(kept);
   }
+  return samples;
+}
 
+// The object's symmetries, and each sample's symmetric labellings (trained
+// against the nearest of them).
+std::vector<ModelSymmetry> AddSymmetricLabellings(const TrainCommand& cmd, const ObjectModel& object,
+                                                  LabelledSamples* samples) {
   const std::vector<ModelSymmetry> symmetries =
       ObjectSymmetries(cmd.symmetry, object, "trained against the nearest of the symmetric labellings");
   std::size_t labelled = 0, total = 0;
-  for (auto* samples : {&train, &validation}) {
-    for (TrainingSample& sample : *samples) {
+  for (auto* set : {&samples->train, &samples->validation}) {
+    for (TrainingSample& sample : *set) {
       sample.symmetric_keypoints = SymmetricLabellings(object, symmetries, sample.keypoints);
       labelled += !sample.symmetric_keypoints.empty();
       ++total;
@@ -163,6 +176,45 @@ int Run(TrainCommand cmd) {
     std::fprintf(stderr, "c3po train: %zu of %zu clouds have symmetric labellings (the others' keypoints are not "
                  "a rigid copy of the object's: plain loss)\n", labelled, total);
   }
+  return symmetries;
+}
+
+// One epoch: a log line (JSON) and a progress line.
+void RecordEpoch(const EpochLog& epoch, EpochLogFile* log) {
+  const nlohmann::json line = {{"phase", "train"}, {"epoch", epoch.epoch}, {"train_loss", epoch.train_loss},
+                               {"val_loss", epoch.val_loss}, {"val_keypoint_error", epoch.val_keypoint_error},
+                               {"seconds", epoch.seconds}, {"labellings_switched", epoch.labellings_switched},
+                               {"best", epoch.best}};
+  log->Record(epoch.epoch, line.dump());
+  std::fprintf(stderr, "epoch %3d  train loss %.3e  val loss %.3e  val keypoint error %.4g  %.1fs%s\n",
+               epoch.epoch, epoch.train_loss, epoch.val_loss, epoch.val_keypoint_error, epoch.seconds,
+               epoch.best ? "  (best)" : "");
+}
+
+// The model file's extra record ("" when there is nothing to say).
+std::string ModelRecord(const TrainCommand& cmd, std::size_t num_symmetries, std::size_t camera_clouds) {
+  nlohmann::json extra = nlohmann::json::object();
+  extra["symmetries"] = num_symmetries;
+  if (!cmd.init_path.empty()) extra["init_model"] = std::filesystem::path(cmd.init_path).filename().string();
+  if (camera_clouds > 0) {
+    extra["camera_instances"] = camera_clouds / static_cast<std::size_t>(std::max(1, cmd.camera.augment.copies));
+    extra["camera_copies"] = cmd.camera.augment.copies;
+  }
+  return extra.empty() ? "" : extra.dump();
+}
+
+int Run(TrainCommand cmd) {
+  if (cmd.detector != "pointnet") {
+    throw InputError("--detector", "'" + cmd.detector + "' is not trainable (trainable: pointnet)");
+  }
+  if (cmd.data_dir.empty() && !cmd.camera.given()) {
+    throw InputError("no labelled clouds given (--data DIR, --bop DIR --obj-id K, or --depth/--mask)");
+  }
+  const ObjectModel object = LoadObject(cmd.object_path);
+  std::unique_ptr<PointNetDetector> detector;
+  const PointNetArchitecture architecture = ResolveArchitecture(object, &cmd, &detector);
+  LabelledSamples samples = LoadLabelled(object, &cmd);
+  const std::vector<ModelSymmetry> symmetries = AddSymmetricLabellings(cmd, object, &samples);
   if (!detector) detector = std::make_unique<PointNetDetector>(object, architecture, cmd.options.seed);
   EpochLogFile log(cmd.output_path);
   if (cmd.resume) {
@@ -173,27 +225,12 @@ int Run(TrainCommand cmd) {
     log.LoadExisting();
   }
   std::fprintf(stderr, "training %s on %zu clouds of %s (%d epochs, batch %d, %s lr %g, n = %d%s%s)\n",
-               cmd.detector.c_str(), train.size(), object.name().c_str(), cmd.options.epochs, cmd.options.batch,
-               cmd.options.optimizer.c_str(), cmd.options.lr, cmd.options.num_points,
+               cmd.detector.c_str(), samples.train.size(), object.name().c_str(), cmd.options.epochs,
+               cmd.options.batch, cmd.options.optimizer.c_str(), cmd.options.lr, cmd.options.num_points,
                cmd.init_path.empty() ? "" : ", from ", cmd.init_path.c_str());
-  const PointNetFitResult result = detector->Fit(train, validation, cmd.options, [&](const EpochLog& epoch) {
-    const nlohmann::json line = {{"phase", "train"}, {"epoch", epoch.epoch}, {"train_loss", epoch.train_loss},
-                                 {"val_loss", epoch.val_loss}, {"val_keypoint_error", epoch.val_keypoint_error},
-                                 {"seconds", epoch.seconds}, {"labellings_switched", epoch.labellings_switched},
-                                 {"best", epoch.best}};
-    log.Record(epoch.epoch, line.dump());
-    std::fprintf(stderr, "epoch %3d  train loss %.3e  val loss %.3e  val keypoint error %.4g  %.1fs%s\n",
-                 epoch.epoch, epoch.train_loss, epoch.val_loss, epoch.val_keypoint_error, epoch.seconds,
-                 epoch.best ? "  (best)" : "");
-  });
-  nlohmann::json extra = nlohmann::json::object();
-  extra["symmetries"] = symmetries.size();
-  if (!cmd.init_path.empty()) extra["init_model"] = std::filesystem::path(cmd.init_path).filename().string();
-  if (!camera.clouds.empty()) {
-    extra["camera_instances"] = camera.clouds.size() / static_cast<std::size_t>(std::max(1, cmd.camera.augment.copies));
-    extra["camera_copies"] = cmd.camera.augment.copies;
-  }
-  detector->Save(cmd.output_path, extra.empty() ? "" : extra.dump());
+  const PointNetFitResult result = detector->Fit(samples.train, samples.validation, cmd.options,
+                                                 [&](const EpochLog& epoch) { RecordEpoch(epoch, &log); });
+  detector->Save(cmd.output_path, ModelRecord(cmd, symmetries.size(), samples.camera_clouds));
   std::printf("wrote %s (best epoch %d, validation loss %.3e, %zu train / %zu validation clouds); log %s\n",
               cmd.output_path.c_str(), result.best_epoch, result.best_val_loss, result.train_samples,
               result.validation_samples, log.path().c_str());
