@@ -82,7 +82,9 @@ const std::vector<std::string>& BopOnlyOptions() {
 void DeclareBopOptions(CLI::App& command, SynthBopCommand& o) {
   const std::string bop = "bop: ";
   command.add_option("--obj-id", o.obj_id, bop + "BOP object id of the target")->capture_default_str();
-  command.add_option("--depth-scale", o.depth_scale, bop + "millimetres per depth-image unit")
+  command.add_option("--depth-scale", o.depth_scale,
+                     bop + "millimetres per depth-image unit, or auto: the finest of 0.1 (YCB-V's), 0.2, 0.5, 1, "
+                           "2, ... that holds the deepest surface in 16 bits")
       ->capture_default_str();
   command.add_option("--images-per-scene", o.images_per_scene, bop + "images per scene folder")
       ->capture_default_str();
@@ -123,7 +125,10 @@ int RunSynthBop(const SynthCommonForBop& common, const SynthBopCommand& o) {
   }
   if (!common.intrinsics.empty()) options.camera = ParseIntrinsics(common.intrinsics);
   options.units_to_mm = 1000.0;   // LoadObject converts every mesh to metres (annotations/README.md)
-  options.depth_scale = Number(o.depth_scale, "--depth-scale");
+  if (o.depth_scale != "auto") {
+    options.depth_scale = Number(o.depth_scale, "--depth-scale");
+    if (!(options.depth_scale > 0.0)) throw InputError("--depth-scale", "must be auto or > 0 mm per unit");
+  }
   options.distractors = o.distractors;
   options.background = !o.no_background;
   options.background_gap = o.background_gap;
@@ -170,7 +175,7 @@ int RunSynthBop(const SynthCommonForBop& common, const SynthBopCommand& o) {
   std::printf("camera fx %.6g fy %.6g cx %.6g cy %.6g, %dx%d, depth_scale %.6g mm; object centre "
               "depth in [%.4g, %.4g] m\n",
               options.camera.fx, options.camera.fy, options.camera.cx, options.camera.cy,
-              options.camera.width, options.camera.height, options.depth_scale,
+              options.camera.width, options.camera.height, generator.options().depth_scale,
               report.distance_range.first, report.distance_range.second);
   std::printf("target: mean visib_fract %.3f, at least %ld visible pixels; %.2f draws per image\n",
               report.mean_target_visib_fract, report.target_visible_pixels_min, report.mean_attempts);
@@ -184,7 +189,7 @@ int RunSynthBop(const SynthCommonForBop& common, const SynthBopCommand& o) {
   }
   if (report.out_of_range > 0) {
     std::printf("%ld pixels beyond 65535 x %.4g mm written as 0 (no measurement)\n",
-                report.out_of_range, options.depth_scale);
+                report.out_of_range, generator.options().depth_scale);
   }
   std::printf("%.2f s (%.1f images/s)\n", report.seconds,
               report.seconds > 0 ? static_cast<double>(report.images) / report.seconds : 0.0);

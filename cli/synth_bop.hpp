@@ -10,7 +10,7 @@ namespace c3po::cli {
 
 struct SynthBopCommand {
   int obj_id = 1;
-  std::string depth_scale = "0.1";
+  std::string depth_scale = "auto";
   int images_per_scene = 1000;
   int distractors = 0;
   std::vector<std::string> distractor_objects;   // FILE.json[:ID]

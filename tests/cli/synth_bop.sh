@@ -92,6 +92,18 @@ expect_error bad7 "--format" "$MUG" --format coco --count 2
 expect_error bad8 "--depth-noise" "$MUG" --format bop --count 2 --depth-noise 0.001
 expect_error bad9 "--distractors" "$MUG" --format bop --count 2 --distractor "$SOURCE/annotations/box.json"
 expect_error bad10 "no-such.json" "$MUG" --format bop --count 2 --distractors 1 --distractor no-such.json
+# The 1.5 m chair at synth's default range does not fit YCB-V's 0.1 mm units:
+# --depth-scale auto (the default) takes the finest of 0.1, 0.2, 0.5, 1, ...
+# mm that holds the deepest surface (oracle: the printed range and diameter).
+"$C3PO" synth "$SOURCE/annotations/chair.json" -o chair --format bop --count 1 "${SMALL[@]}" --seed 3 \
+  > chair.log 2>&1 || { cat chair.log; fail "synth chair with the default depth scale"; }
+far_mm=$(sed -n 's/.*depth in \[[0-9.e-]*, \([0-9.e-]*\)\] m.*/\1/p' chair.log)
+chair_mm=$(sed -n 's/.*d = \([0-9.e-]*\) m.*/\1/p' chair.log | awk '{print $1 * 1000}')
+expected=$(awk -v z="$far_mm" -v d="$chair_mm" 'BEGIN { far = z * 1000 + d;
+  n = split("0.1 0.2 0.5 1 2 5 10", s, " "); for (i = 1; i <= n; ++i) if (far / s[i] <= 65535) { print s[i]; exit } }')
+[ -n "$expected" ] && [ "$expected" != 0.1 ] || { cat chair.log; fail "chair: expected a scale above 0.1 (far $far_mm m)"; }
+grep -q "depth_scale $expected mm" chair.log || { cat chair.log; fail "chair: depth scale should be $expected"; }
+check chair 1000 1 "$chair_mm" 0
 # An existing folder that is not ours is refused and left alone.
 mkdir precious; echo keep > precious/notes.txt
 "$C3PO" synth "$MUG" -o precious --format bop --count 1 > err.log 2>&1

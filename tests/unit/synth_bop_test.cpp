@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <vector>
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
@@ -292,7 +294,7 @@ TEST_CASE("synth bop: interruption leaves nothing, impossible options are refuse
     CHECK_THROWS_AS(c3po::BopSceneGenerator({&object.mesh(), 1}, {}, o), c3po::InputError);
   };
   refused([](auto& o) { o.count = 0; });
-  refused([](auto& o) { o.depth_scale = 0.0; });
+  refused([](auto& o) { o.depth_scale = -0.1; });
   refused([](auto& o) { o.depth_scale = 0.001; });   // 65535 x 0.001 mm cannot hold ~1 m
   refused([](auto& o) { o.pose.mode = c3po::PoseMode::kPaper; });
   refused([](auto& o) { o.min_visib_fract = 1.5; });
@@ -310,6 +312,49 @@ TEST_CASE("synth bop: interruption leaves nothing, impossible options are refuse
   CHECK_THROWS_AS(hopeless.Generate(0, renderer.get()), c3po::InputError);
   CHECK_THROWS_AS(c3po::WriteBopDataset(hopeless, tmp / "never"), c3po::InputError);
   CHECK(fs::is_empty(tmp.path()));
+}
+
+TEST_CASE("synth bop depth scale: auto is the finest 1-2-5 step holding the deepest surface, 0.1 when it fits") {
+  // Oracle: the series written out, the first step that holds far_mm in 16 bits.
+  const std::vector<double> series{0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0};
+  for (const double far_mm : {1.0, 1000.0, 6553.5, 6553.6, 9000.0, 13107.0, 13107.1, 40000.0, 1.0e6}) {
+    CAPTURE(far_mm);
+    const auto fits = std::find_if(series.begin(), series.end(), [&](double s) { return far_mm / s <= 65535.0; });
+    REQUIRE(fits != series.end());
+    CHECK(c3po::FinestDepthScale(far_mm) == doctest::Approx(*fits).epsilon(1e-12));
+  }
+  CHECK_THROWS(c3po::FinestDepthScale(0.0));
+  CHECK_THROWS(c3po::FinestDepthScale(std::numeric_limits<double>::quiet_NaN()));
+
+  const c3po::ObjectModel object = c3po::test::AsymmetricObject(100);
+  c3po::BopSynthOptions options = SmallOptions();
+  options.background = false;
+  options.min_visib_fract = 0.0;
+  options.min_visible_pixels = 1;
+  // Near: YCB-V's 0.1 mm (the WriteBopDataset case above checks the written file).
+  REQUIRE(c3po::BopSceneGenerator({&object.mesh(), 1}, {}, options).options().depth_scale == 0.1);
+  // Far: 8-9 m cannot be held at 0.1 mm (6.5535 m) but can at 0.2 mm (13.107 m).
+  options.pose.distance_min = 8.0;
+  options.pose.distance_max = 9.0;
+  const double far_mm = (9.0 + object.diameter()) * 1000.0;
+  REQUIRE(far_mm < 13107.0);
+  const c3po::BopSceneGenerator generator({&object.mesh(), 1}, {}, options);
+  CHECK(generator.options().depth_scale == doctest::Approx(0.2));
+  // The depth image decodes with it: every measured pixel lies within the target's depth range.
+  auto renderer = generator.MakeRenderer();
+  const c3po::SynthBopImage image = generator.Generate(0, renderer.get());
+  long measured = 0;
+  for (const std::uint16_t units : image.depth) {
+    if (units == 0) continue;
+    ++measured;
+    const double z = units * generator.options().depth_scale / 1000.0;
+    CHECK((z > 8.0 - object.diameter() && z < 9.0 + object.diameter()));
+  }
+  CHECK(measured > 0);
+  CHECK(image.out_of_range == 0);
+  // An explicit scale that cannot hold it is still refused.
+  options.depth_scale = 0.1;
+  CHECK_THROWS_AS(c3po::BopSceneGenerator({&object.mesh(), 1}, {}, options), c3po::InputError);
 }
 
 TEST_CASE("synth bop realistic preset: target segments look like real YCB-Video segments"
@@ -340,7 +385,7 @@ TEST_CASE("synth bop realistic preset: target segments look like real YCB-Video 
       for (int u = 0; u < camera.width; u += 2) {
         const std::size_t p = static_cast<std::size_t>(v) * camera.width + u;
         if (!target.mask_visib[p] || image.depth[p] == 0) continue;
-        const double z = image.depth[p] * options.depth_scale / 1000.0;
+        const double z = image.depth[p] * generator.options().depth_scale / 1000.0;
         const Eigen::Vector3d x((u - camera.cx) * z / camera.fx, (v - camera.cy) * z / camera.fy, z);
         distances.push_back(c3po::ClosestSurfacePoint(posed, x).distance);
       }

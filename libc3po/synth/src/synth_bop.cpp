@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "c3po/base/error.hpp"
@@ -64,6 +65,18 @@ CameraIntrinsics YcbvCamera() {
   return camera;
 }
 
+double FinestDepthScale(double far_mm) {
+  if (!(far_mm > 0.0) || !std::isfinite(far_mm)) throw std::invalid_argument("FinestDepthScale: far_mm must be > 0");
+  double decade = 0.1;
+  for (;;) {
+    for (const double step : {1.0, 2.0, 5.0}) {
+      const double scale = step * decade;
+      if (far_mm / scale <= 65535.0) return scale;
+    }
+    decade *= 10.0;
+  }
+}
+
 void BopSynthOptions::Check() const {
   if (count < 1) throw InputError("--count: must be at least 1");
   if (images_per_scene < 1 || images_per_scene > 1000000) {
@@ -73,8 +86,8 @@ void BopSynthOptions::Check() const {
   pose.Check();
   camera.Check();
   if (!(units_to_mm > 0.0) || !std::isfinite(units_to_mm)) throw InputError("units: scale to mm must be > 0");
-  if (!(depth_scale > 0.0) || !std::isfinite(depth_scale) || depth_scale > 1000.0) {
-    throw InputError("--depth-scale: must be in (0, 1000] mm per unit");
+  if (depth_scale != 0.0 && (!(depth_scale > 0.0) || !std::isfinite(depth_scale) || depth_scale > 1000.0)) {
+    throw InputError("--depth-scale: must be auto or in (0, 1000] mm per unit");
   }
   if (distractors < 0 || distractors > 100) throw InputError("--distractors: must be in [0, 100]");
   if (!(max_table_tilt >= 0.0 && max_table_tilt <= 1.0)) {
@@ -103,7 +116,10 @@ BopSceneGenerator::BopSceneGenerator(SynthBopObject target, std::vector<SynthBop
                   : std::make_pair(pose.distance_min, pose.distance_max);
   // The deepest surface must fit in 16-bit depth units.
   const double far_mm = (distance_.second + objects_[0].diameter) * options_.units_to_mm;
-  if (far_mm / options_.depth_scale > 65535.0) {
+  if (options_.depth_scale == 0.0 && std::isfinite(far_mm) && far_mm > 0.0) {
+    options_.depth_scale = FinestDepthScale(far_mm);
+  }
+  if (!(options_.depth_scale > 0.0 && options_.depth_scale <= 1000.0) || far_mm / options_.depth_scale > 65535.0) {
     char message[256];
     std::snprintf(message, sizeof message,
                   "--depth-scale: %g mm per unit cannot store depths up to %.0f mm in 16 bits "

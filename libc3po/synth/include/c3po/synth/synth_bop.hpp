@@ -50,13 +50,21 @@ struct SynthBopObject {
 // YCB-Video's camera (BOP ycbv camera_uw.json): 640 x 480.
 CameraIntrinsics YcbvCamera();
 
+// The finest depth scale (mm per unit) of the series 0.1, 0.2, 0.5, 1, 2, 5,
+// 10, ... at which 16-bit units hold depths up to far_mm (BOP datasets use
+// 0.1 and 1). far_mm must be finite and > 0.
+double FinestDepthScale(double far_mm);
+
 struct BopSynthOptions {
   int count = 1;                   // images
   int images_per_scene = 1000;
   PoseSamplerOptions pose;         // kPaper is refused
   CameraIntrinsics camera = YcbvCamera();
   double units_to_mm = 1000.0;     // scene (object) units -> mm: 1000 for m, 1 for mm
-  double depth_scale = 0.1;        // mm per depth-image unit (YCB-V: 0.1)
+  // mm per depth-image unit; 0 = auto: FinestDepthScale of the deepest
+  // surface (0.1 = YCB-V's whenever it fits, e.g. every YCB object at its
+  // default distance; the bundled chair at 3-9 m gets 0.2).
+  double depth_scale = 0.0;
   int distractors = 0;             // further instances per image
   bool background = true;          // the table plane
   double max_table_tilt = 0.5235987755982988;   // 30 deg
