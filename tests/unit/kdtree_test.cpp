@@ -209,3 +209,48 @@ TEST_CASE("non-finite queries find no neighbour, like an empty tree") {
   CHECK(indices(1) >= 0);
   CHECK(std::isfinite(squared(1)));
 }
+
+TEST_CASE("Nearest with a hint is exactly Nearest: any hint, duplicates, far queries, non-finite queries") {
+  c3po::Rng rng(16);
+  for (int n : {1, 2, 11, 500, 3000}) {
+    CAPTURE(n);
+    const PointSet data = PointsWithDuplicates(rng, n);
+    const PointTree tree(data);
+    const PointSet queries = Queries(rng, data, 300);
+    for (Eigen::Index q = 0; q < queries.cols(); ++q) {
+      const Eigen::Vector3d query = queries.col(q);
+      const auto plain = tree.Nearest(query);
+      // Oracle: brute force; the hinted answer is the same point (ties included) and distance.
+      const double best = SortedSquaredDistances(data, query).front();
+      CHECK(plain.squared_distance == doctest::Approx(best).epsilon(1e-12).scale(1));
+      const Eigen::Index good = plain.index;                                  // the exact answer
+      const Eigen::Index random = rng.UniformInt(n);                          // an arbitrary point
+      const Eigen::Index bad_hints[] = {-1, n, std::numeric_limits<Eigen::Index>::max()};  // no hint
+      for (const Eigen::Index hint : {good, random, bad_hints[0], bad_hints[1], bad_hints[2]}) {
+        CAPTURE(hint);
+        const auto hinted = tree.Nearest(query, hint);
+        CHECK(hinted.index == plain.index);
+        CHECK(hinted.squared_distance == plain.squared_distance);
+      }
+    }
+    // The batch with hints (a permutation of the answers: mostly wrong hints) equals the plain batch.
+    Eigen::VectorXi plain_indices, hinted_indices, hints(queries.cols());
+    Eigen::VectorXd plain_squared, hinted_squared;
+    tree.NearestBatch(queries, &plain_indices, &plain_squared);
+    for (Eigen::Index q = 0; q < queries.cols(); ++q) hints(q) = plain_indices((q * 7 + 3) % queries.cols());
+    tree.NearestBatch(queries, &hinted_indices, &hinted_squared, &hints);
+    CHECK(hinted_indices == plain_indices);
+    CHECK(hinted_squared == plain_squared);
+    // Hints of the wrong length are ignored.
+    const Eigen::VectorXi short_hints = hints.head(queries.cols() / 2);
+    tree.NearestBatch(queries, &hinted_indices, &hinted_squared, &short_hints);
+    CHECK(hinted_indices == plain_indices);
+  }
+  const PointTree tree(RandomPoints(rng, 100));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto none = tree.Nearest(Eigen::Vector3d(nan, 0, 0), 5);
+  CHECK(none.index == -1);
+  CHECK(std::isinf(none.squared_distance));
+  const PointTree empty{PointSet(3, 0)};
+  CHECK(empty.Nearest(Eigen::Vector3d::Zero(), 0).index == -1);
+}

@@ -46,8 +46,6 @@ void ExpectInputError(Load load, const std::string& file, const std::string& fie
   }
 }
 
-void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
-
 }  // namespace
 
 TEST_CASE("the fixture object loads with every field") {

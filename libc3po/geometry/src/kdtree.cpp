@@ -1,5 +1,6 @@
 #include "c3po/geometry/kdtree.hpp"
 
+#include <cmath>
 #include <limits>
 #include <nanoflann.hpp>
 
@@ -50,6 +51,33 @@ PointTree& PointTree::operator=(PointTree&& other) noexcept {
   return *this;
 }
 
+namespace {
+
+// nanoflann result set of one neighbour whose search starts bounded: the
+// nearest point strictly closer than `bound` (squared). Same rule as
+// KNNResultSet(1): a point replaces the kept one only when strictly closer,
+// so among equidistant points the first visited wins, as without a bound.
+class BoundedNearest {
+ public:
+  explicit BoundedNearest(double bound) : best_(bound) {}
+  bool addPoint(double squared_distance, Eigen::Index index) {
+    if (squared_distance < best_) {
+      best_ = squared_distance;
+      index_ = index;
+    }
+    return true;
+  }
+  double worstDist() const { return best_; }
+  bool full() const { return index_ >= 0; }
+  Eigen::Index index() const { return index_; }
+
+ private:
+  double best_;
+  Eigen::Index index_ = -1;
+};
+
+}  // namespace
+
 PointTree::Neighbor PointTree::Nearest(const Eigen::Vector3d& query) const {
   Neighbor neighbor;
   if (!index_) {
@@ -61,6 +89,22 @@ PointTree::Neighbor PointTree::Nearest(const Eigen::Vector3d& query) const {
   index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
   // A non-finite (or overflowing) query finds nothing: report it like an empty tree.
   if (neighbor.index < 0) neighbor.squared_distance = std::numeric_limits<double>::infinity();
+  return neighbor;
+}
+
+PointTree::Neighbor PointTree::Nearest(const Eigen::Vector3d& query, Eigen::Index hint) const {
+  if (!index_ || hint < 0 || hint >= points_.cols()) return Nearest(query);
+  const double hinted = (query - points_.col(hint)).squaredNorm();
+  // The nearest point is no farther than the hint; the margin covers rounding
+  // differences between this distance and nanoflann's (its test is strict).
+  const double bound = hinted * (1.0 + 1e-9) + std::numeric_limits<double>::min();
+  if (!std::isfinite(bound)) return Nearest(query);
+  BoundedNearest result(bound);
+  index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  if (result.index() < 0) return Nearest(query);   // cannot happen for a finite query; stay exact anyway
+  Neighbor neighbor;
+  neighbor.index = result.index();
+  neighbor.squared_distance = result.worstDist();
   return neighbor;
 }
 
@@ -77,9 +121,10 @@ std::vector<PointTree::Neighbor> PointTree::KNearest(const Eigen::Vector3d& quer
   return neighbors;
 }
 
-void PointTree::NearestBatch(const PointSet& queries, Eigen::VectorXi* indices,
-                             Eigen::VectorXd* squared_distances) const {
+void PointTree::NearestBatch(const PointSet& queries, Eigen::VectorXi* indices, Eigen::VectorXd* squared_distances,
+                             const Eigen::VectorXi* hints) const {
   const Eigen::Index n = queries.cols();
+  if (hints && hints->size() != n) hints = nullptr;
   if (indices) indices->resize(n);
   if (squared_distances) squared_distances->resize(n);
   constexpr int kChunk = 256;
@@ -87,7 +132,7 @@ void PointTree::NearestBatch(const PointSet& queries, Eigen::VectorXi* indices,
   auto run_chunk = [&](int c) {
     const Eigen::Index end = std::min<Eigen::Index>(n, (c + 1) * Eigen::Index{kChunk});
     for (Eigen::Index i = c * Eigen::Index{kChunk}; i < end; ++i) {
-      const Neighbor nb = Nearest(queries.col(i));
+      const Neighbor nb = hints ? Nearest(queries.col(i), (*hints)(i)) : Nearest(queries.col(i));
       if (indices) (*indices)(i) = static_cast<int>(nb.index);
       if (squared_distances) (*squared_distances)(i) = nb.squared_distance;
     }

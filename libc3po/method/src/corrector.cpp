@@ -90,6 +90,8 @@ struct Kernel {
 };
 
 // L_pc of `points` at `pose`, with the nearest B̂ point of every input point.
+// `hints`: the nearest points of `points` at a nearby pose (the previous
+// iterate's), which make the search faster and change nothing.
 struct PoseFit {
   Pose pose;
   Eigen::VectorXi nearest;
@@ -98,10 +100,10 @@ struct PoseFit {
 };
 
 PoseFit FitAtPose(const ObjectModel& object, const PointSet& points, const Pose& pose,
-                  PointCloudLoss loss, const Kernel& kernel = {}) {
+                  PointCloudLoss loss, const Kernel& kernel = {}, const Eigen::VectorXi* hints = nullptr) {
   PoseFit fit;
   fit.pose = pose;
-  object.NearestInPosedModel(points, pose, &fit.nearest, &fit.squared);
+  object.NearestInPosedModel(points, pose, &fit.nearest, &fit.squared, hints);
   if (points.cols() > 0) {
     if (loss == PointCloudLoss::kMeanSquared && kernel.active()) {
       double sum = 0.0;
@@ -160,7 +162,7 @@ StageResult RunPointToPointStage(const ObjectModel& object, const PointSet& poin
     const RegistrationResult step = RegisterPoints(matched, points, weights);
     if (!step.ok()) break;
     const double previous = fit.loss;
-    fit = FitAtPose(object, points, step.scene_from_model, loss, kernel);
+    fit = FitAtPose(object, points, step.scene_from_model, loss, kernel, &fit.nearest);
     ++stage.iterations;
     if (fit.loss < stage.best.loss) stage.best = fit;
     if (SmallDecrease(previous, fit.loss, tolerance)) {
@@ -220,7 +222,7 @@ StageResult RunPointToPlaneStage(const ObjectModel& object, const PointSet& poin
       const Eigen::Matrix<double, 6, 1> delta = damped.ldlt().solve(-Jtr);
       if (!delta.allFinite()) break;
       PoseFit candidate = FitAtPose(object, points, ApplyIncrement(fit.pose, delta),
-                                    PointCloudLoss::kMeanSquared, kernel);
+                                    PointCloudLoss::kMeanSquared, kernel, &fit.nearest);
       ++stage.iterations;
       if (candidate.loss < fit.loss) {
         fit = std::move(candidate);

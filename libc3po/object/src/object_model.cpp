@@ -118,11 +118,10 @@ std::string ObjectModel::KeypointHash() const {
   return text;
 }
 
-void ObjectModel::NearestInPosedModel(const PointSet& scene, const Pose& scene_from_model,
-                                      Eigen::VectorXi* indices,
-                                      Eigen::VectorXd* squared_distances) const {
+void ObjectModel::NearestInPosedModel(const PointSet& scene, const Pose& scene_from_model, Eigen::VectorXi* indices,
+                                      Eigen::VectorXd* squared_distances, const Eigen::VectorXi* hints) const {
   // ||x - (R p + t)|| = ||R^T (x - t) - p||: query the model-frame tree.
-  tree_->NearestBatch(scene_from_model.InverseApply(scene), indices, squared_distances);
+  tree_->NearestBatch(scene_from_model.InverseApply(scene), indices, squared_distances, hints);
 }
 
 Eigen::VectorXd ObjectModel::DistancesToPosedModel(const PointSet& scene,

@@ -69,8 +69,10 @@ class ObjectModel {
 
   // Nearest model-sample point of every scene point under pose T, computed as
   // queries of R^T (x - t) against the model-frame tree (no per-pose rebuild).
-  void NearestInPosedModel(const PointSet& scene, const Pose& scene_from_model,
-                           Eigen::VectorXi* indices, Eigen::VectorXd* squared_distances) const;
+  // `hints` (one sample index per scene point, e.g. its nearest at the
+  // previous iterate) give the same result faster (PointTree::Nearest).
+  void NearestInPosedModel(const PointSet& scene, const Pose& scene_from_model, Eigen::VectorXi* indices,
+                           Eigen::VectorXd* squared_distances, const Eigen::VectorXi* hints = nullptr) const;
   // Distances (not squared) of every scene point to the posed model sample.
   Eigen::VectorXd DistancesToPosedModel(const PointSet& scene, const Pose& scene_from_model) const;
 
