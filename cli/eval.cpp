@@ -274,6 +274,7 @@ int Run(const EvalCommand& cmd) {
   for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});
   std::vector<TrainingLog> logs;
   if (!cmd.report.path.empty()) logs = ReadTrainingLogs(cmd, loaded);   // fail before the long work
+  CheckEvaluationDataset(object, dataset, detectors);                       // before the symmetry search
   for (const ModelSymmetry& symmetry :
        ObjectSymmetries(cmd.symmetry, object, "rotation and translation errors to the nearest symmetric truth")) {
     options.symmetries.push_back(symmetry.model_from_model);

@@ -462,6 +462,24 @@ TEST_CASE("mixed dataset: rows from the object's clouds only, other objects' clo
   }
   CHECK_THROWS_WITH_AS(Evaluate(f.object, cubes, {{"manifest", nullptr, false}}, options),
                        doctest::Contains("no cloud of object"), InputError);
+
+  // An own cloud without ground truth is named by its line of the whole
+  // manifest (entries alternate own, cube: own cloud k is line 2k + 1); other
+  // objects' clouds need none.
+  Dataset no_truth = mixed;
+  no_truth.entries[1].pose.reset();
+  CHECK_NOTHROW(CheckEvaluationDataset(f.object, no_truth, {{"manifest", nullptr, false}}));
+  no_truth.entries[4].pose.reset();
+  const std::string line5 = "manifest.jsonl: line 5 (" + mixed.entries[4].cloud + "): no ground-truth";
+  CHECK_THROWS_WITH_AS(CheckEvaluationDataset(f.object, no_truth, {{"manifest", nullptr, false}}),
+                       doctest::Contains(line5.c_str()), InputError);
+  CHECK_THROWS_WITH_AS(Evaluate(f.object, no_truth, {{"manifest", nullptr, false}}, options),
+                       doctest::Contains("line 5 ("), InputError);
+  Dataset no_keypoints = mixed;
+  no_keypoints.entries[2].detected_keypoints.reset();
+  const std::string line3 = "line 3 (" + mixed.entries[2].cloud + "): --detector manifest needs";
+  CHECK_THROWS_WITH_AS(CheckEvaluationDataset(f.object, no_keypoints, {{"manifest", nullptr, false}}),
+                       doctest::Contains(line3.c_str()), InputError);
 }
 
 TEST_CASE("frames: every row's certificate includes the frame's free space, a frame without depth changes nothing") {

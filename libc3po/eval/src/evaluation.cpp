@@ -180,19 +180,14 @@ DetectorResults EvaluateDetector(const ObjectModel& object, const Dataset& datas
   return out;
 }
 
-void CheckDataset(const Dataset& dataset, const std::vector<EvaluatedDetector>& detectors) {
-  const std::string where = dataset.dir + "/manifest.jsonl";
-  if (dataset.entries.empty()) throw InputError(where, "the dataset has no clouds");
-  const bool needs_manifest_keypoints =
-      std::any_of(detectors.begin(), detectors.end(), [](const EvaluatedDetector& d) { return !d.detector; });
+// The indices of the dataset's clouds that show `object` (all of them unless
+// the set is mixed).
+std::vector<std::size_t> OwnIndices(const ObjectModel& object, const Dataset& dataset) {
+  std::vector<std::size_t> own;
   for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
-    const DatasetEntry& entry = dataset.entries[i];
-    const std::string line = where + ": line " + std::to_string(i + 1) + " (" + entry.cloud + ")";
-    if (!entry.pose) throw InputError(line, "no ground-truth pose (\"R\", \"t\"): eval needs ground truth");
-    if (needs_manifest_keypoints && !entry.detected_keypoints) {
-      throw InputError(line, "--detector manifest needs \"detected_keypoints\"");
-    }
+    if (dataset.Shows(i, object.name())) own.push_back(i);
   }
+  return own;
 }
 
 void AppendRows(const EvaluatedDetector& detector, DetectorResults results,
@@ -375,6 +370,26 @@ RowSummary Summarize(const std::vector<SampleResult>& samples, const EvaluationO
   return summary;
 }
 
+void CheckEvaluationDataset(const ObjectModel& object, const Dataset& dataset,
+                            const std::vector<EvaluatedDetector>& detectors) {
+  const std::string where = dataset.dir + "/manifest.jsonl";
+  if (dataset.entries.empty()) throw InputError(where, "the dataset has no clouds");
+  const std::vector<std::size_t> own = OwnIndices(object, dataset);
+  if (own.empty()) {
+    throw InputError(where, "no cloud of object '" + object.name() + "' (every line's \"object\" names another)");
+  }
+  const bool needs_manifest_keypoints =
+      std::any_of(detectors.begin(), detectors.end(), [](const EvaluatedDetector& d) { return !d.detector; });
+  for (std::size_t i : own) {
+    const DatasetEntry& entry = dataset.entries[i];
+    const std::string line = where + ": line " + std::to_string(i + 1) + " (" + entry.cloud + ")";
+    if (!entry.pose) throw InputError(line, "no ground-truth pose (\"R\", \"t\"): eval needs ground truth");
+    if (needs_manifest_keypoints && !entry.detected_keypoints) {
+      throw InputError(line, "--detector manifest needs \"detected_keypoints\"");
+    }
+  }
+}
+
 Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
                     const std::vector<EvaluatedDetector>& detectors,
                     const EvaluationOptions& options, const ProgressCallback& progress,
@@ -383,22 +398,13 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
   if (detectors.empty()) throw std::invalid_argument("Evaluate: no detectors");
   // Mixed datasets: the object's own clouds make the rows, the others are
   // only certified and counted (per label).
+  CheckEvaluationDataset(object, dataset, detectors);
   Dataset own_dataset, other_dataset;
   own_dataset.dir = other_dataset.dir = dataset.dir;
-  std::vector<std::size_t> own_index;
+  const std::vector<std::size_t> own_index = OwnIndices(object, dataset);
   for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
-    if (dataset.Shows(i, object.name())) {
-      own_dataset.entries.push_back(dataset.entries[i]);
-      own_index.push_back(i);
-    } else {
-      other_dataset.entries.push_back(dataset.entries[i]);
-    }
+    (dataset.Shows(i, object.name()) ? own_dataset : other_dataset).entries.push_back(dataset.entries[i]);
   }
-  if (own_dataset.entries.empty() && !dataset.entries.empty()) {
-    throw InputError(dataset.dir + "/manifest.jsonl",
-                     "no cloud of object '" + object.name() + "' (every line's \"object\" names another)");
-  }
-  CheckDataset(own_dataset, detectors);
   const std::size_t count = own_dataset.entries.size();
   const std::vector<CloudSource> sources = DatasetSources(own_dataset, frames);
   std::vector<DetectorResults> results;

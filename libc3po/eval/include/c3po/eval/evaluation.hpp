@@ -193,14 +193,22 @@ EvaluationRow MakeEvaluationRow(EvalMethod method, EvalSubset subset, const std:
                                 const std::vector<SampleResult>& all_samples, const EvaluationOptions& options,
                                 double diameter);
 
+// The checks Evaluate makes before any work, for callers that want to fail
+// before their own long preparation (eval's symmetry search): InputError
+// ("dir/manifest.jsonl: ...") when the dataset has no cloud, no cloud shows
+// the object, or a cloud that shows it has no ground-truth pose or, for a
+// manifest detector (EvaluatedDetector::detector null), no
+// detected_keypoints (naming its line of the manifest).
+void CheckEvaluationDataset(const ObjectModel& object, const Dataset& dataset,
+                            const std::vector<EvaluatedDetector>& detectors);
+
 // Runs every detector on every cloud of the dataset (in parallel over clouds)
 // that shows the object (Dataset::Shows: no label or the object's name; the
 // rows' sample indices are the dataset's entries; in a mixed dataset the other
 // labels' clouds only fill Evaluation::objects; InputError when no cloud shows
 // the object) and returns the rows in the order: for each detector, its KeyPo, + ICP,
 // + RANSAC + ICP, + corrector rows (or its three C-3PO rows when self-trained). Throws
-// InputError("dir/manifest.jsonl: ...") when an entry has no ground-truth pose
-// or, for a manifest detector, no detected_keypoints; std::invalid_argument
+// CheckEvaluationDataset's InputErrors; std::invalid_argument
 // for bad options. Unreadable clouds and detector failures are per-sample
 // failures. `progress` is called (from worker threads) after each cloud.
 // `frames` (when given) names the depth frame each entry's cloud came from
