@@ -6,6 +6,7 @@ set -uo pipefail
 C3PO=$(realpath "$1"); WORK=$(realpath -m "$3")
 rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
 fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/lib.sh"
 
 # A 200 x 100 x 50 mm box, in millimetres.
 cat > box_mm.obj <<'OBJ'
@@ -48,14 +49,9 @@ grep -q '"auto0"' box.json || fail "auto keypoint names"
 expect_error() {
   local what=$1; shift
   rm -f bad.json bad.html
-  "$C3PO" "$@" > bad.out 2> bad.err
-  local status=$?
-  [ $status -eq 2 ] || { cat bad.out bad.err; fail "$what: exit $status, expected 2"; }
-  # One line (CLI11 usage errors add a "Run with --help" hint).
-  [ "$(grep -vc 'Run with --help' bad.err)" -eq 1 ] || { cat bad.err; fail "$what: expected one line on stderr"; }
-  [ ! -e bad.json ] || fail "$what: wrote bad.json"
+  expect_bad_input bad.json "" "$C3PO" "$@" || return 1
   [ ! -e bad.html ] || fail "$what: wrote bad.html"
-  echo "ok: $what -> $(head -1 bad.err)"
+  echo "ok: $what -> $(head -1 bad_input.err)"
 }
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' > no_faces.obj
 expect_error "non-numeric coordinate" annotate box_mm.obj --units mm -o bad.json --keypoint 0.1,x,0
@@ -68,7 +64,7 @@ expect_error "remove out of range" annotate --edit box.json --remove 7 -o bad.js
 expect_error "missing --from-json file" annotate box_mm.obj --units mm -o bad.json --from-json none.json --key k
 echo '[{"class_id": "1", "model_id": "m1", "keypoints": [{"xyz": [0, 0, 0], "semantic_id": 1}]}]' > kpnet.json
 expect_error "unknown KeypointNet model id" annotate box_mm.obj --units mm -o bad.json --from-keypointnet kpnet.json --model-id m2
-grep -q "model id 'm2' not found" bad.err || fail "unknown model id message"
+grep -q "model id 'm2' not found" bad_input.err || fail "unknown model id message"
 
 # Import from the shared YCB keypoints (skipped without the shared data).
 YCB=$(realpath -m "$2/../shared/data/ycb/025_mug")

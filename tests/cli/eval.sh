@@ -10,6 +10,7 @@ C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
 rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
 OBJECT="$SRC/annotations/mug.json"
 fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/lib.sh"
 
 "$C3PO" synth "$OBJECT" -o data --kind depth --count 10 --points 400 --seed 5 --perturb-sigma 0.3 >/dev/null 2>&1 \
   || fail "c3po synth could not make the dataset"
@@ -97,9 +98,7 @@ grep -q "Failures: KeyPo (manifest): 1 of 10 samples without a pose.*000003.ply"
 cp report.html report.before
 expect_error() {   # expect_error PATTERN ARGS...
   local pattern=$1; shift
-  set +e; "$C3PO" eval "$@" > bad.txt 2>&1; local status=$?; set -e
-  [ $status -eq 2 ] || { cat bad.txt; fail "expected exit 2 for '$*', got $status"; }
-  grep -q -- "$pattern" bad.txt || { cat bad.txt; fail "message for '$*' lacks '$pattern'"; }
+  expect_bad_input - "$pattern" "$C3PO" eval "$@"
 }
 expect_error "data" "$OBJECT" --detector manifest --report report.html
 expect_error "at least one" "$OBJECT" --data data --report report.html

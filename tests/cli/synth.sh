@@ -6,6 +6,7 @@ set -uo pipefail
 C3PO=$(realpath "$1"); SOURCE=$(realpath "$2"); WORK=$(realpath -m "$3")
 rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
 fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/lib.sh"
 BOX="$SOURCE/annotations/box.json"
 
 # Depth clouds with perturbed detected keypoints, twice with the same seed.
@@ -52,14 +53,7 @@ fi
 # Bad inputs: exit 2, one line on stderr naming the problem, no dataset.
 expect_error() {   # expect_error OUTPUT_DIR PATTERN ARGS...
   local out=$1 pattern=$2; shift 2
-  "$C3PO" synth "$@" -o "$out" > err.log 2>&1
-  local status=$?
-  [ "$status" -eq 2 ] || { cat err.log; fail "exit $status (expected 2) for: $*"; }
-  [ "$(wc -l < err.log)" -eq 1 ] || { cat err.log; fail "expected one line for: $*"; }
-  grep -q -- "$pattern" err.log || { cat err.log; fail "message should mention '$pattern'"; }
-  [ ! -e "$out" ] || fail "$out left behind for: $*"
-  ls -a "$(dirname "$out")" | grep -q '\.partial\.' && fail "temporary folder left behind for: $*"
-  return 0
+  expect_bad_input "$out" "$pattern" "$C3PO" synth "$@" -o "$out"
 }
 expect_error bad1 "count" "$BOX" --kind sim --count 0
 expect_error bad2 "kind" "$BOX" --kind lidar --count 3

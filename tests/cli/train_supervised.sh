@@ -18,6 +18,7 @@ rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
 MUG="$SRC/annotations/mug.json"; BOX="$SRC/annotations/box.json"
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+source "$(dirname "$0")/lib.sh"
 [ "${C3PO_WITH_POINTNET:-ON}" == OFF ] && { echo "pointnet not built: skipped"; exit 77; }
 
 "$C3PO" synth "$MUG" -o bop --format bop --count 6 --obj-id 4 --intrinsics 400,400,159.5,119.5,320,240 --seed 3 \
@@ -108,13 +109,10 @@ PY
 grep -q "19 of 20 clouds have symmetric labellings" boxbent.err || fail "train bent label: $(grep -v '^  ' boxbent.err | head -4)"
 grep -q '"labellings_switched":[1-9]' boxplain.model.log.jsonl && fail "plain MSE switched labellings"
 
-# expect_error NAME TEXT ARGS...: exit 2, one stderr line containing TEXT, no model written.
+# expect_error NAME TEXT ARGS...: exit 2, one stderr line containing TEXT, no model written (lib.sh).
 expect_error() {
   local name=$1 text=$2; shift 2
-  "$C3PO" train "$@" -o "$name.model" > "$name.out" 2> "$name.err"; local status=$?
-  [ $status -eq 2 ] || fail "$name: exit $status, expected 2"
-  [ "$(wc -l < "$name.err")" -eq 1 ] && grep -q -- "$text" "$name.err" || fail "$name: stderr: $(cat "$name.err")"
-  [ ! -e "$name.model" ] || fail "$name: wrote a model"
+  expect_bad_input "$name.model" "$text" "$C3PO" train "$@" -o "$name.model"
 }
 expect_error no_input "no labelled clouds given" "$MUG"
 expect_error obj99 "no instances of obj_id 99" "$MUG" --bop bop --obj-id 99
