@@ -6,21 +6,11 @@
 // indicator sets remapped (sets containing it dropped), and the download
 // button yields the object JSON (saved to DOWNLOAD.json for `c3po annotate --edit`).
 import path from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { check, testPage } from './page_harness.mjs';
 
 const [playwrightDir, pagePath, expectedText, boxText, downloadPath] = process.argv.slice(2);
-const { chromium } = await import(pathToFileURL(path.join(playwrightDir, 'node_modules/playwright-core/index.mjs')).href);
 const expected = Number(expectedText);
 const box = boxText.split(',').map(Number);
-
-function check(condition, message) {
-  if (!condition) {
-    console.error('FAIL: ' + message);
-    process.exitCode = 1;
-    throw new Error(message);
-  }
-  console.log('ok: ' + message);
-}
 
 // Distance of p to the surface of the box [0,X]x[0,Y]x[0,Z] (p inside or on it).
 function boxSurfaceDistance(p) {
@@ -38,29 +28,9 @@ function expectedSetsAfterRemoving(sets, i) {
   return sets.filter(s => !s.includes(i)).map(s => s.map(j => (j > i ? j - 1 : j)));
 }
 
-const userDataDir = path.join(path.dirname(downloadPath), 'chromium-profile');
-const context = await chromium.launchPersistentContext(userDataDir, {
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  acceptDownloads: true,
-  viewport: {width: 1000, height: 700},
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-         '--disable-background-networking', '--disable-component-update', '--disable-sync',
-         '--enable-unsafe-swiftshader'],
-});
-try {
-  const page = context.pages()[0] || await context.newPage();
-  const errors = [];
-  const requests = [];
-  page.on('console', message => { if (message.type() === 'error') errors.push(message.text()); });
-  page.on('pageerror', error => errors.push(error.message));
-  page.on('request', request => {
-    const url = request.url();
-    if (!url.startsWith('file:') && !url.startsWith('blob:') && !url.startsWith('data:')) requests.push(url);
-  });
-
-  await page.goto(pathToFileURL(path.resolve(pagePath)).href);
-  await page.waitForFunction(() => document.body.dataset.ready === '1', null, {timeout: 30000});
+const options = {profileDir: path.join(path.dirname(downloadPath), 'chromium-profile'),
+                 viewport: {width: 1000, height: 700}, acceptDownloads: true, readyTimeout: 30000};
+await testPage(playwrightDir, pagePath, options, async page => {
   check(await page.evaluate(() => !!window.c3poDebug), 'the 3D view was created (WebGL available)');
 
   const count = () => page.evaluate(() => window.c3poState.keypoints.length);
@@ -101,14 +71,4 @@ try {
   const saved = JSON.parse(await (await import('node:fs/promises')).readFile(downloadPath, 'utf8'));
   check(saved.keypoints.length === expected && JSON.stringify(saved.indicator_sets) === JSON.stringify(after.indicator_sets),
         'downloaded JSON has the page state');
-
-  check(errors.length === 0, 'no console errors' + (errors.length ? ': ' + errors.join(' | ') : ''));
-  check(requests.length === 0, 'no network requests' + (requests.length ? ': ' + requests.join(' ') : ''));
-} catch (error) {
-  if (!process.exitCode) {
-    console.error('FAIL: ' + error.message);
-    process.exitCode = 1;
-  }
-} finally {
-  await context.close();
-}
+});

@@ -5,46 +5,15 @@
 // there; the 3D view has a WebGL canvas that draws points (non-background
 // pixels), a mouse drag orbits the camera, the example buttons switch views
 // and every rejected example names why it was refused.
-import path from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { check, testPage } from './page_harness.mjs';
 
 const [playwrightDir, pagePath, rowsText, profileDir] = process.argv.slice(2);
-const { chromium } = await import(pathToFileURL(path.join(playwrightDir, 'node_modules/playwright-core/index.mjs')).href);
 // EXPECTED_ROWS "certify": the page of `c3po certify --report` (no results table).
 const certifyReport = rowsText === 'certify';
 const expectedRows = Number(rowsText);
 
-function check(condition, message) {
-  if (!condition) {
-    console.error('FAIL: ' + message);
-    process.exitCode = 1;
-    throw new Error(message);
-  }
-  console.log('ok: ' + message);
-}
-
-const context = await chromium.launchPersistentContext(profileDir, {
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  viewport: {width: 1200, height: 900},
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-         '--disable-background-networking', '--disable-component-update', '--disable-sync',
-         '--enable-unsafe-swiftshader'],
-});
-try {
-  const page = context.pages()[0] || await context.newPage();
-  const errors = [];
-  const requests = [];
-  page.on('console', message => { if (message.type() === 'error') errors.push(message.text()); });
-  page.on('pageerror', error => errors.push(error.message));
-  page.on('request', request => {
-    const url = request.url();
-    if (!url.startsWith('file:') && !url.startsWith('blob:') && !url.startsWith('data:')) requests.push(url);
-  });
-
-  await page.goto(pathToFileURL(path.resolve(pagePath)).href);
-  await page.waitForFunction(() => document.body.dataset.ready === '1', null, {timeout: 60000});
-
+const options = {profileDir, viewport: {width: 1200, height: 900}, readyTimeout: 60000};
+await testPage(playwrightDir, pagePath, options, async page => {
   if (certifyReport) {
     const rows = await page.locator('table#refusals tbody tr').count();
     check(rows >= 2, `refusal table lists certified and refused poses (${rows} rows)`);
@@ -100,14 +69,4 @@ try {
     check(info.includes('refused by ') === !certified,
           `example ${i} (${certified ? 'certified' : 'rejected'}) ${certified ? 'has no' : 'names its'} refusal`);
   }
-
-  check(errors.length === 0, 'no console errors' + (errors.length ? ': ' + errors.join(' | ') : ''));
-  check(requests.length === 0, 'no network requests' + (requests.length ? ': ' + requests.join(' ') : ''));
-} catch (error) {
-  if (!process.exitCode) {
-    console.error('FAIL: ' + error.message);
-    process.exitCode = 1;
-  }
-} finally {
-  await context.close();
-}
+});
