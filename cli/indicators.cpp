@@ -97,6 +97,7 @@ int RunAuto(const IndicatorsCommand& cmd, ObjectModel& object) {
   options.training.noise_sigma = cmd.noise_text;
   options.degeneracy.eps_oc = Threshold(cmd.eps_oc_text, object.spec().eps_oc, object.diameter(), "--eps-oc");
   options.degeneracy.delta_nd = Threshold(cmd.delta_nd_text, object.spec().delta_nd, object.diameter(), "--delta-nd");
+  options.Check();   // before the first line of output
   const int deliberate = static_cast<int>(DeliberateViews(object, options.deliberate_views).size());
   const int total =
       deliberate + options.training.views + (options.test_views > 0 ? options.test_views : options.training.views);

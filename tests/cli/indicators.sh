@@ -9,6 +9,7 @@ set -uo pipefail
 C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
 rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
 fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/lib.sh"
 
 cp "$SRC/annotations/mug.json" "$SRC/annotations/mug.obj" .
 
@@ -20,13 +21,15 @@ echo "$out" | grep -q "set 1: {9 handle_middle}" || fail "list names: $out"
 # Invalid edits: exit 2, one line naming the problem, file unchanged.
 cp mug.json original.json
 for args in "--set 1,99" "--set 2,2" "--set 9" "--remove 3" "--set x"; do
-  "$C3PO" indicators mug.json $args > err.txt 2>&1
-  status=$?
-  [ $status -eq 2 ] || fail "'$args' exit $status"
-  [ "$(wc -l < err.txt)" -eq 1 ] || fail "'$args' message: $(cat err.txt)"
+  expect_bad_input mug.json.bak "" "$C3PO" indicators mug.json $args
   cmp -s mug.json original.json || fail "'$args' changed the file"
 done
-[ ! -e mug.json.bak ] || fail "a failed edit left a backup"
+# --auto's options are checked before any work or output.
+expect_bad_input mug.json.bak "--views" "$C3PO" indicators mug.json --auto --views 0 --write
+expect_bad_input mug.json.bak "--test-views" "$C3PO" indicators mug.json --auto --test-views 0 --write
+expect_bad_input mug.json.bak "--max-set-size" "$C3PO" indicators mug.json --auto --max-set-size 7 --write
+[ -s bad_input.out ] && fail "--auto printed before refusing: $(cat bad_input.out)"
+cmp -s mug.json original.json || fail "a refused --auto changed the file"
 
 # Edit to -o: the input stays, the output has the new sets.
 "$C3PO" indicators mug.json --remove 0 --set 0,4 -o edited.json > /dev/null || fail "edit -o"
