@@ -15,6 +15,7 @@
 #include "c3po/object/object_io.hpp"
 #include "c3po/web/annotation_page.hpp"
 #include "command.hpp"
+#include "options.hpp"
 
 namespace c3po::cli {
 namespace {
@@ -43,7 +44,8 @@ struct AnnotateCommand {
 
 void Declare(CLI::App& command, AnnotateCommand& o) {
   command.add_option("mesh", o.mesh, "Mesh file (OBJ, PLY, STL, OFF, glTF, ...); optional with --edit");
-  command.add_option("-o,--output", o.output, "Object JSON to write (may be the --edit file)")->required();
+  command.add_option("-o,--output", o.output, "Object JSON to write (may be the --edit file)")
+      ->check(WritableFile())->required();
   command.add_option("--units", o.units, "Units of the mesh file (default m, or the edited object's)")
       ->check(CLI::IsMember({"m", "cm", "mm"}));
   command.add_option("--keypoint", o.keypoints, "Keypoint X,Y,Z in metres (repeatable), snapped to the surface")
@@ -68,7 +70,7 @@ void Declare(CLI::App& command, AnnotateCommand& o) {
   command.add_option("--remove", o.remove, "Remove keypoint I of the edited object (repeatable)")
       ->allow_extra_args(false);
   command.add_flag("--drop-sets", o.drop_sets, "Drop indicator sets that contain a removed keypoint");
-  command.add_option("--html", o.html, "Also write the self-contained annotation page");
+  command.add_option("--html", o.html, "Also write the self-contained annotation page")->check(WritableFile());
   command.add_option("--eps-oc", o.eps_oc, "Observable-correctness threshold (distance or 3%d)");
   command.add_option("--delta-nd", o.delta_nd, "Non-degeneracy threshold (distance or 1.5%d)");
   command.add_option("--object-name", o.object_name, "Object name (default: mesh file stem)");

@@ -175,10 +175,10 @@ void SetupCorrectorBench(CLI::App& parent, std::function<int()>* run) {
                                              "(distance or fraction of d; default 0.02)");
   AddThreadsOption(*sub, &cmd->threads, "1 gives honest per-cloud times");
   sub->add_option("--max-clouds", cmd->max_clouds, "Use at most this many clouds (0 = all)");
-  sub->add_option("--json", cmd->json_path, "Also write the rows as JSON to this file");
+  sub->add_option("--json", cmd->json_path, "Also write the rows as JSON to this file")->check(WritableFile());
   sub->add_option("--cases", cmd->cases_path,
                   "Also write every case (input keypoints, result) and the model sample as JSON lines "
-                  "(input of libc3po/eval/bench/pytorch_corrector_gd.py)");
+                  "(input of libc3po/eval/bench/pytorch_corrector_gd.py)")->check(WritableFile());
   sub->footer("Example:\n  c3po bench corrector drill.json --data data/drill_depth --sigma 0.1,0.3,0.5 --solvers fast,gd");
   sub->callback([cmd, run]() { *run = [cmd]() { return RunCorrectorBench(*cmd); }; });
 }

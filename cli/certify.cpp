@@ -347,7 +347,8 @@ RunFunction SetupCertify(CLI::App& command) {
   command.add_option("--data", cmd->data_dir, "Dataset folder (manifest.jsonl + clouds)");
   AddDetectorOptions(command, &cmd->detector, DetectorCount::kOne);
   command.add_flag("--json", cmd->json, "One JSON object per cloud on stdout");
-  command.add_option("-o,--output", cmd->output_path, "Write the JSON lines to this file (atomically)");
+  command.add_option("-o,--output", cmd->output_path, "Write the JSON lines to this file (atomically)")
+      ->check(WritableFile());
   AddThresholdOptions(command, &cmd->thresholds, AutoEpsOc::kAllowed);
   command.add_flag("--no-correct", cmd->no_correct,
                    "Certify the plain registration of the detected keypoints (with --poses: the given pose as is)");
@@ -361,7 +362,8 @@ RunFunction SetupCertify(CLI::App& command) {
   AddSegmentOptions(command, &cmd->segment);
   command.add_option("--bop-csv", cmd->bop_csv_path,
                      "Write BOP results CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm; score: certified first); "
-                     "with --poses one row per instance: its chosen hypothesis, else its best fit");
+                     "with --poses one row per instance: its chosen hypothesis, else its best fit")
+      ->check(WritableFile());
   AddShardOption(command, &cmd->shard, "clouds (by image for --bop, by cloud or manifest line otherwise)");
   AddReportOptions(command, &cmd->report,
                    "poses certified and refused by each certificate part, 3D examples with the reason and the "

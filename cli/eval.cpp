@@ -350,9 +350,12 @@ RunFunction SetupEval(CLI::App& command) {
   command.add_option("--icp-iterations", cmd->icp_iterations, "ICP iterations (default 30)");
   command.add_option("--icp-max-distance", cmd->icp_max_distance, "ICP correspondence gate (default: none)");
   command.add_option("--icp-trim", cmd->icp_trim, "ICP: fraction of the farthest pairs dropped (default 0)");
-  command.add_option("--json", cmd->json_path, "Write everything as JSON to FILE (atomically); '-' = stdout (table on stderr)");
+  command.add_option("--json", cmd->json_path,
+                     "Write everything as JSON to FILE (atomically); '-' = stdout (table on stderr)")
+      ->check(WritableFile(true));
   command.add_option("--samples", cmd->samples_path,
-                     "Write the per-sample rows as JSON lines (atomically), for c3po merge --eval of --shard parts");
+                     "Write the per-sample rows as JSON lines (atomically), for c3po merge --eval of --shard parts")
+      ->check(WritableFile());
   AddShardOption(command, &cmd->shard, "clouds (by manifest line for --data, by image for --bop)");
   AddReportOptions(command, &cmd->report, "the results table, soundness, ADD-S plots, training curves, 3D examples");
   command.add_option("--training-log", cmd->training_logs,

@@ -11,6 +11,7 @@
 #include "c3po/io/dataset.hpp"
 #include "c3po/object/object_io.hpp"
 #include "command.hpp"
+#include "options.hpp"
 #include "progress_bar.hpp"
 
 namespace c3po::cli {
@@ -181,7 +182,9 @@ RunFunction SetupIndicators(CLI::App& command) {
   command.add_option("--set", cmd->add_sets, "Add a set of keypoint indices, e.g. 0,1,3 (repeatable)");
   command.add_option("--remove", cmd->remove_sets, "Remove set K (index as listed; repeatable)");
   command.add_flag("--clear", cmd->clear, "Remove every set (before --set)");
-  command.add_option("-o,--output", cmd->output_path, "Write the object here (default: in place, keeping OBJECT.json.bak)");
+  command.add_option("-o,--output", cmd->output_path,
+                     "Write the object here (default: in place, keeping OBJECT.json.bak)")
+      ->check(WritableFile());
   command.add_option("--coverage", cmd->coverage_dir, "Dataset with ground-truth poses: how often each set is seen");
   command.add_option("--delta-nd", cmd->delta_nd_text, "'Seen' threshold: distance or fraction of d (1.5%d); default: the object's");
   command.add_option("--eps-oc", cmd->eps_oc_text, "--auto: fit threshold of the degeneracy search; default: the object's");

@@ -6,12 +6,27 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/io/camera_io.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/registry.hpp"
 
 namespace c3po::cli {
+
+CLI::Validator WritableFile(bool dash_is_stdout) {
+  return CLI::Validator(
+      [dash_is_stdout](std::string& path) -> std::string {
+        if (dash_is_stdout && path == "-") return "";
+        try {
+          CheckWritableFile(path);
+        } catch (const InputError& error) {
+          return error.what();
+        }
+        return "";
+      },
+      "FILE");
+}
 
 void AddThresholdOptions(CLI::App& command, ThresholdFlags* flags, AutoEpsOc auto_eps_oc) {
   flags->auto_mode = auto_eps_oc;
@@ -312,7 +327,7 @@ void ReportFlags::Check() const {
 }
 
 void AddReportOptions(CLI::App& command, ReportFlags* flags, const std::string& contents) {
-  command.add_option("--report", flags->path, "Write a self-contained HTML report: " + contents);
+  command.add_option("--report", flags->path, "Write a self-contained HTML report: " + contents)->check(WritableFile());
   command.add_option("--views", flags->views,
                      "3D examples in the report: this many certified and rejected (default 3)");
 }

@@ -25,6 +25,12 @@
 
 namespace c3po::cli {
 
+// The CLI11 check of an output file option (-o, --report, --json, ...): the
+// file can be written there now (CheckWritableFile: its folder exists and
+// takes a new file), so a typo in the path fails at once, not after the run.
+// `dash_is_stdout`: "-" passes (the option's stdout spelling).
+CLI::Validator WritableFile(bool dash_is_stdout = false);
+
 // --report FILE and --views N of certify and eval (the HTML reports).
 struct ReportFlags {
   std::string path;   // "" = no report

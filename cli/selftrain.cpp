@@ -306,7 +306,8 @@ RunFunction SetupSelftrain(CLI::App& command) {
   command.add_option("object", cmd->object_path, "Object JSON")->required();
   command.add_option("--model", cmd->model_path, "Trained model (e.g. from c3po train on sim data)")->required();
   command.add_option("--data", cmd->data_dir, "Unlabelled dataset (ground truth, if any, is only reported)");
-  command.add_option("-o,--output", cmd->output_path, "Self-trained model file to write")->required();
+  command.add_option("-o,--output", cmd->output_path, "Self-trained model file to write")
+      ->check(WritableFile())->required();
   command.add_option("--epochs", o.epochs, "Maximum epochs");
   command.add_option("--batch", o.batch, "Batch size");
   command.add_option("--lr", cmd->lr, "Learning rate");

@@ -244,7 +244,7 @@ RunFunction SetupTrain(CLI::App& command) {
   PointNetTrainOptions& o = cmd->options;
   command.add_option("object", cmd->object_path, "Object JSON")->required();
   command.add_option("--data", cmd->data_dir, "Labelled dataset (manifest with keypoints)");
-  command.add_option("-o,--output", cmd->output_path, "Model file to write")->required();
+  command.add_option("-o,--output", cmd->output_path, "Model file to write")->check(WritableFile())->required();
   command.add_option("--validation", cmd->validation_dir, "Labelled validation dataset (default: hold out --val-fraction)");
   command.add_option("--detector", cmd->detector, "Trainable detector (pointnet)");
   command.add_option("--epochs", o.epochs, "Epochs");

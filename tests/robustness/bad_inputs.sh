@@ -261,6 +261,20 @@ printf 'a regular file\n' > blocker
 check certify_output_unwritable "2" blocker/out.jsonl blocker sim -- "$C3PO" certify "$CUBE" --detector svd --data sim -o blocker/out.jsonl
 [ "${C3PO_WITH_POINTNET:-ON}" == OFF ] || check train_output_unwritable "2" blocker/x.model blocker sim -- "$C3PO" train "$CUBE" --data sim -o blocker/x.model --epochs 1 --point-mlp 8 8 --head 8 --points 32
 check synth_output_unwritable "2" blocker/ds blocker "$CUBE" -- "$C3PO" synth "$CUBE" -o blocker/ds --kind sim --count 2 --points 50
+# Every output file option is checked when the command line is read, before
+# any work: a typo in an output path must not cost the run (nothing on stdout).
+check certify_report_unwritable "2" blocker/r.html blocker sim -- "$C3PO" certify "$CUBE" --detector svd --data sim --report blocker/r.html
+check certify_csv_unwritable "2" blocker/r.csv blocker sim -- "$C3PO" certify "$CUBE" --detector svd --data sim --bop-csv blocker/r.csv
+check eval_json_unwritable "2" blocker/e.json blocker sim -- "$C3PO" eval "$CUBE" --detector svd --data sim --json blocker/e.json
+check eval_samples_unwritable "2" blocker/e.jsonl blocker sim -- "$C3PO" eval "$CUBE" --detector svd --data sim --samples blocker/e.jsonl
+check bench_json_unwritable "2" blocker/b.json blocker sim -- "$C3PO" bench corrector "$CUBE" --data sim --json blocker/b.json
+check annotate_html_unwritable "2" blocker/a.html blocker cube.obj -- "$C3PO" annotate cube.obj --auto 3 -o a.json --html blocker/a.html
+check indicators_output_unwritable "2" blocker/i.json blocker cube.json -- "$C3PO" indicators "$CUBE" -o blocker/i.json
+[ ! -e a.json ] || { echo "annotate wrote a.json although its --html could not be written"; failures=$((failures + 1)); }
+for name in certify_output_unwritable certify_report_unwritable certify_csv_unwritable eval_json_unwritable \
+            eval_samples_unwritable bench_json_unwritable; do
+  [ ! -s "$name.out" ] || { echo "$name: printed results before refusing the output path"; failures=$((failures + 1)); }
+done
 [ "${C3PO_WITH_POINTNET:-ON}" == OFF ] || check train_empty_dataset "2" e.model no_manifest no_manifest -- "$C3PO" train "$CUBE" --data no_manifest -o e.model --epochs 1
 # --- selftrain's selection and ambiguity options (issue 18): out of range => one line naming selftrain
 if [ "${C3PO_WITH_POINTNET:-ON}" != OFF ] && [ -e cube.model ]; then

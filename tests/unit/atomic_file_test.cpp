@@ -96,6 +96,32 @@ TEST_CASE("an unwritable destination gives InputError and no output") {
   CHECK(std::filesystem::is_empty(dir / "readonly"));
 }
 
+TEST_CASE("CheckWritableFile fails exactly where WriteFileAtomically fails, and creates nothing") {
+  c3po::test::TempDir dir("atomic_check");
+  c3po::WriteFileAtomically(dir / "file", std::string("a regular file"));
+  std::filesystem::create_directory(dir / "folder");
+  std::filesystem::create_directory(dir / "readonly");
+  std::filesystem::permissions(dir / "readonly", std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+  const std::vector<std::string> before = Listing(dir.path());
+  const std::vector<std::string> paths = {dir / "new.txt", dir / "file", dir / "file/out.txt", dir / "missing/out.txt",
+                                          dir / "folder", dir / "folder/", dir / "readonly/out.txt", ""};
+  for (const std::string& path : paths) {
+    CAPTURE(path);
+    const bool existed = std::filesystem::exists(path);
+    const std::string checked = InputErrorOf([&] { c3po::CheckWritableFile(path); });
+    CHECK(Listing(dir.path()) == before);   // the check leaves nothing
+    CHECK(std::filesystem::is_empty(dir / "readonly"));
+    // The oracle: what the write itself says (a read-only folder stops it
+    // only for users other than root, and the check agrees either way).
+    const std::string written = InputErrorOf([&] { c3po::WriteFileAtomically(path, std::string("x")); });
+    CHECK(checked == written);
+    if (written.empty() && !existed) std::filesystem::remove(path);
+  }
+  CHECK(InputErrorOf([&] { c3po::CheckWritableFile(dir / "missing/out.txt"); }) ==
+        dir / "missing/out.txt: cannot write: No such file or directory");
+  std::filesystem::permissions(dir / "readonly", std::filesystem::perms::owner_all);
+}
+
 TEST_CASE("ReadFileToString errors name the file") {
   c3po::test::TempDir dir("atomic_read");
   CHECK(InputErrorOf([&] { c3po::ReadFileToString(dir / "none"); }) == dir / "none: cannot read: No such file or directory");

@@ -121,6 +121,17 @@ void WriteFileAtomically(const std::string& path,
   if (sync) SyncFolder(ParentOf(path));
 }
 
+void CheckWritableFile(const std::string& path) {
+  if (path.empty() || path.back() == '/') throw InputError(path, "cannot write: not a file name");
+  struct stat status {};
+  if (::stat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode)) Fail(path, EISDIR);
+  const std::string temporary = TemporarySibling(path);
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) Fail(path, errno);
+  ::close(fd);
+  ::unlink(temporary.c_str());
+}
+
 void WriteFileAtomically(const std::string& path, const std::string& contents) {
   WriteFileAtomically(path, [&contents](std::ostream& out) {
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));

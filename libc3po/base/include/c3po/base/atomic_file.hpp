@@ -18,6 +18,13 @@ void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write, bool sync = true);
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
+// Throws WriteFileAtomically's InputError("path: cannot write: reason") now
+// if it would fail later for want of a place: `path` is no file name or is a
+// folder, or its folder is missing or takes no new file (tried by creating and
+// removing the temporary sibling; nothing is left). For commands to call
+// before long work, so that a typo in an output path does not cost the run.
+void CheckWritableFile(const std::string& path);
+
 // A folder published atomically: files are written into a hidden sibling
 // ".<name>.partial.<pid>" (path()), and Commit() syncs it once and renames it
 // to `dir`. An existing `dir` is replaced only when it is empty or holds the
