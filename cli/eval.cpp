@@ -219,29 +219,33 @@ std::string CommandLine(const EvalCommand& cmd) {
   return line;
 }
 
-int Run(const EvalCommand& cmd) {
-  const ObjectModel object = LoadObject(cmd.object_path);
-  if (cmd.data_dir.empty() == cmd.bop.dir.empty()) throw InputError("give exactly one of --data DIR or --bop DIR");
-  // Fractions of d: the dataset's own diameter (models_info.json) when
-  // evaluating BOP data, else the object's bounding-box diagonal.
-  double diameter = object.diameter();
+// Fractions of d: the dataset's own diameter (models_info.json) when
+// evaluating BOP data, else the object's bounding-box diagonal.
+double EvaluationDiameter(const EvalCommand& cmd, const ObjectModel& object) {
   const std::string models_info = cmd.bop.dir.empty() ? "" : FindModelsInfo(cmd);
-  if (!models_info.empty()) {
-    const auto info = ParseModelsInfo(ReadFileToString(models_info), models_info);
-    const auto it = info.find(cmd.bop.options.obj_id);
-    if (it != info.end()) {
-      diameter = it->second.diameter_mm * kMetresPerMillimetre;
-      std::cerr << "c3po eval: d = " << diameter << " (diameter of obj_id " << cmd.bop.options.obj_id << " in " << models_info << ")\n";
-    }
-  }
-  EvaluationOptions options = MakeOptions(cmd, object, diameter);
-  cmd.report.Check();
-  const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
+  if (models_info.empty()) return object.diameter();
+  const auto info = ParseModelsInfo(ReadFileToString(models_info), models_info);
+  const auto it = info.find(cmd.bop.options.obj_id);
+  if (it == info.end()) return object.diameter();
+  const double diameter = it->second.diameter_mm * kMetresPerMillimetre;
+  std::cerr << "c3po eval: d = " << diameter << " (diameter of obj_id " << cmd.bop.options.obj_id << " in "
+            << models_info << ")\n";
+  return diameter;
+}
+
+// The clouds to evaluate: --data's dataset, or --bop's instances written as
+// one into `scratch` (with each instance's depth frame, for the free-space
+// test); this --shard part of either.
+struct EvalData {
+  Dataset dataset;
+  DatasetFrames frames;
+};
+EvalData ReadEvalData(const EvalCommand& cmd, const ObjectModel& object, const std::optional<Shard>& shard,
+                      const ScratchFolder& scratch) {
   const std::string empty_part = "this part holds no clouds (choose N at most the number of " +
                                  std::string(cmd.bop.dir.empty() ? "manifest lines)" : "images with usable instances)");
-  ScratchFolder scratch;
+  EvalData data;
   std::string data_dir = cmd.data_dir;
-  DatasetFrames frames;   // --bop: each instance's depth frame, for the free-space test
   if (!cmd.bop.dir.empty()) {
     CheckSegmentOptions(cmd.segment, "c3po eval");
     auto listed_shared = std::make_shared<const BopInstances>(ListBopInstances(cmd.bop.dir, cmd.bop.options));
@@ -252,46 +256,24 @@ int Run(const EvalCommand& cmd) {
     if (instances.empty()) throw InputError("--shard " + cmd.shard, empty_part);
     data_dir = scratch.path() + "/dataset";
     const BopDatasetSummary summary = WriteDatasetFromBop(instances, object.keypoints(), cmd.segment, data_dir);
-    frames = BopDatasetFrames(listed_shared, instances, cmd.segment);
+    data.frames = BopDatasetFrames(listed_shared, instances, cmd.segment);
     for (const std::string& reason : summary.skipped) std::cerr << "c3po eval: skipped " << reason << "\n";
     std::cerr << "c3po eval: " << summary.written << " BOP instances of obj_id " << cmd.bop.options.obj_id << " ("
               << summary.skipped.size() << " skipped)\n";
   }
-  Dataset dataset = ReadDataset(data_dir);
+  data.dataset = ReadDataset(data_dir);
   // --shard by manifest line (a BOP run was sharded above).
-  if (shard && cmd.bop.dir.empty()) dataset = ShardDataset(dataset, *shard);
-  if (shard && dataset.entries.empty()) throw InputError("--shard " + cmd.shard, empty_part);
-  if (!cmd.samples_path.empty()) {   // sample files hold the object's rows, not a mixed set's per-object counts
-    for (std::size_t i = 0; i < dataset.entries.size(); ++i) {
-      if (!dataset.Shows(i, object.name())) {
-        throw InputError(data_dir, "--samples: the dataset holds other objects' clouds (a mixed set); sample files "
-                                   "do not carry its per-object acceptance, so evaluate a mixed set unsharded");
-      }
-    }
-  }
-  const std::vector<LoadedDetector> loaded = LoadDetectors(cmd, object);
-  std::vector<EvaluatedDetector> detectors;
-  for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});
-  std::vector<TrainingLog> logs;
-  if (!cmd.report.path.empty()) logs = ReadTrainingLogs(cmd, loaded);   // fail before the long work
-  CheckEvaluationDataset(object, dataset, detectors);                       // before the symmetry search
-  for (const ModelSymmetry& symmetry :
-       ObjectSymmetries(cmd.symmetry, object, "rotation and translation errors to the nearest symmetric truth")) {
-    options.symmetries.push_back(symmetry.model_from_model);
-  }
+  if (shard && cmd.bop.dir.empty()) data.dataset = ShardDataset(data.dataset, *shard);
+  if (shard && data.dataset.entries.empty()) throw InputError("--shard " + cmd.shard, empty_part);
+  return data;
+}
 
-  ProgressBar progress("eval", dataset.entries.size());
-  Evaluation evaluation =
-      Evaluate(object, dataset, detectors, options, [&](std::size_t done, std::size_t) { progress.Update(done); },
-               frames);
-  progress.Finish();
-  // BOP input: name the BOP folder, not the temporary dataset it became.
-  if (!cmd.bop.dir.empty()) evaluation.dataset_dir = cmd.bop.dir;
+// The per-sample rows (--samples), the JSON document (--json) and the table.
+void WriteEvalOutputs(const EvalCommand& cmd, const std::optional<Shard>& shard, const Evaluation& evaluation) {
   if (!cmd.samples_path.empty()) {
     WriteFileAtomically(cmd.samples_path, EvaluationSamplesJsonl(evaluation, shard ? cmd.shard : "1/1"));
     std::cerr << "wrote " << cmd.samples_path << "\n";
   }
-
   const bool json_to_stdout = cmd.json_path == "-";
   (json_to_stdout ? std::cerr : std::cout) << EvaluationTable(evaluation);
   if (json_to_stdout) {
@@ -300,21 +282,61 @@ int Run(const EvalCommand& cmd) {
     WriteFileAtomically(cmd.json_path, EvaluationJson(evaluation));
     std::cerr << "wrote " << cmd.json_path << "\n";
   }
-  if (!cmd.report.path.empty()) {
-    ReportInput report;
-    report.evaluation = &evaluation;
-    report.training = std::move(logs);
-    report.command_line = CommandLine(cmd);
-    ReportViewOptions view_options;
-    view_options.certified = cmd.report.views;
-    view_options.rejected = cmd.report.views;
-    if (const EvaluationRow* row = evaluation.MainRow()) {
-      report.views = SelectReportViews(object, dataset, *row, options.adds_threshold, view_options);
-    }
-    WriteReport(cmd.report.path, report);
-    std::cerr << "wrote " << cmd.report.path << " (" << report.views.size() << " 3D examples, "
-              << report.training.size() << " training logs)\n";
+}
+
+void WriteEvalReport(const EvalCommand& cmd, const ObjectModel& object, const Dataset& dataset,
+                     const EvaluationOptions& options, const Evaluation& evaluation, std::vector<TrainingLog> logs) {
+  ReportInput report;
+  report.evaluation = &evaluation;
+  report.training = std::move(logs);
+  report.command_line = CommandLine(cmd);
+  ReportViewOptions view_options;
+  view_options.certified = cmd.report.views;
+  view_options.rejected = cmd.report.views;
+  if (const EvaluationRow* row = evaluation.MainRow()) {
+    report.views = SelectReportViews(object, dataset, *row, options.adds_threshold, view_options);
   }
+  WriteReport(cmd.report.path, report);
+  std::cerr << "wrote " << cmd.report.path << " (" << report.views.size() << " 3D examples, "
+            << report.training.size() << " training logs)\n";
+}
+
+int Run(const EvalCommand& cmd) {
+  const ObjectModel object = LoadObject(cmd.object_path);
+  if (cmd.data_dir.empty() == cmd.bop.dir.empty()) throw InputError("give exactly one of --data DIR or --bop DIR");
+  EvaluationOptions options = MakeOptions(cmd, object, EvaluationDiameter(cmd, object));
+  cmd.report.Check();
+  const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
+  ScratchFolder scratch;
+  const EvalData data = ReadEvalData(cmd, object, shard, scratch);
+  if (!cmd.samples_path.empty()) {   // sample files hold the object's rows, not a mixed set's per-object counts
+    for (std::size_t i = 0; i < data.dataset.entries.size(); ++i) {
+      if (!data.dataset.Shows(i, object.name())) {
+        throw InputError(data.dataset.dir, "--samples: the dataset holds other objects' clouds (a mixed set); sample "
+                                           "files do not carry its per-object acceptance, so evaluate a mixed set "
+                                           "unsharded");
+      }
+    }
+  }
+  const std::vector<LoadedDetector> loaded = LoadDetectors(cmd, object);
+  std::vector<EvaluatedDetector> detectors;
+  for (const auto& d : loaded) detectors.push_back({d.label, d.detector.get(), d.self_trained});
+  std::vector<TrainingLog> logs;
+  if (!cmd.report.path.empty()) logs = ReadTrainingLogs(cmd, loaded);   // fail before the long work
+  CheckEvaluationDataset(object, data.dataset, detectors);              // before the symmetry search
+  for (const ModelSymmetry& symmetry :
+       ObjectSymmetries(cmd.symmetry, object, "rotation and translation errors to the nearest symmetric truth")) {
+    options.symmetries.push_back(symmetry.model_from_model);
+  }
+
+  ProgressBar progress("eval", data.dataset.entries.size());
+  Evaluation evaluation = Evaluate(object, data.dataset, detectors, options,
+                                   [&](std::size_t done, std::size_t) { progress.Update(done); }, data.frames);
+  progress.Finish();
+  // BOP input: name the BOP folder, not the temporary dataset it became.
+  if (!cmd.bop.dir.empty()) evaluation.dataset_dir = cmd.bop.dir;
+  WriteEvalOutputs(cmd, shard, evaluation);
+  if (!cmd.report.path.empty()) WriteEvalReport(cmd, object, data.dataset, options, evaluation, std::move(logs));
   return 0;
 }
 
