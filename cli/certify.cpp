@@ -247,22 +247,14 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
   return instances_certified == static_cast<int>(verdicts.size()) && !verdicts.empty() ? 0 : 1;
 }
 
-int Run(const CertifyCommand& cmd) {
-  const std::size_t detectors = cmd.detector.models.size() + cmd.detector.detectors.size();
-  if (!cmd.poses_path.empty() && detectors != 0) {
-    throw InputError("--poses replaces the detector: give no --model / --detector with it");
-  }
-  if (cmd.poses_path.empty() && detectors != 1) {
-    throw InputError("give exactly one of --model FILE, --detector NAME or --poses FILE");
-  }
-  cmd.report.Check();
-  const ObjectModel object = LoadObject(cmd.object_path);
+// The batch options from the flags: corrector, thresholds, and the measured
+// defaults of camera inputs (options.hpp InputKind), printed in the summary
+// and carried by every JSON line.
+CertifyBatchOptions CertifyOptions(const CertifyCommand& cmd, const ObjectModel& object) {
   CertifyBatchOptions options;
   options.pipeline.correct = !cmd.no_correct;
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
-  // Camera inputs get the measured defaults (options.hpp InputKind), printed
-  // in the summary and carried by every JSON line.
   const InputKind input = cmd.frame.given() || !cmd.bop.dir.empty() ? InputKind::kCameraFrames : InputKind::kClouds;
   ResolveRobust(cmd.robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
   options.auto_eps_oc = cmd.thresholds.auto_eps_oc();
@@ -270,8 +262,12 @@ int Run(const CertifyCommand& cmd) {
     throw InputError("--eps-oc", "auto estimates the threshold from all clouds of a run; with --shard give a value");
   }
   CheckSegmentOptions(cmd.segment, "c3po certify");
-  const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
+  return options;
+}
 
+// Every cloud given: cloud files, --data's dataset, a --depth/--mask frame,
+// --bop's instances, in that order.
+std::vector<CloudSource> CertifySources(const CertifyCommand& cmd) {
   std::vector<CloudSource> sources = CloudFileSources(cmd.clouds);
   const auto append = [&sources](const std::vector<CloudSource>& more) {
     sources.insert(sources.end(), more.begin(), more.end());
@@ -291,6 +287,40 @@ int Run(const CertifyCommand& cmd) {
   if (sources.empty()) {
     throw InputError("no clouds given (CLOUD..., --data DIR, --depth/--mask or --bop DIR)");
   }
+  return sources;
+}
+
+// The human lines or JSON lines (stdout or -o), errors on stderr, --bop-csv.
+void WriteCertifyResults(const CertifyCommand& cmd, const std::vector<CloudSource>& sources,
+                         const CertifyBatchResult& result) {
+  std::ostringstream json_lines;
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    const CloudOutcome& outcome = result.outcomes[i];
+    if (!outcome.processed()) std::cerr << "c3po certify: " << outcome.error << "\n";
+    if (cmd.json || !cmd.output_path.empty()) json_lines << CertifyJsonLine(sources[i], outcome) << "\n";
+    if (outcome.processed() && !cmd.json) std::cout << HumanLine(sources[i].name, outcome) << "\n";
+  }
+  if (!cmd.bop_csv_path.empty()) WriteFileAtomically(cmd.bop_csv_path, BopCsv(BopResultRows(sources, result)));
+  if (!cmd.output_path.empty()) {
+    WriteFileAtomically(cmd.output_path, json_lines.str());
+  } else if (cmd.json) {
+    std::cout << json_lines.str();
+  }
+}
+
+int Run(const CertifyCommand& cmd) {
+  const std::size_t detectors = cmd.detector.models.size() + cmd.detector.detectors.size();
+  if (!cmd.poses_path.empty() && detectors != 0) {
+    throw InputError("--poses replaces the detector: give no --model / --detector with it");
+  }
+  if (cmd.poses_path.empty() && detectors != 1) {
+    throw InputError("give exactly one of --model FILE, --detector NAME or --poses FILE");
+  }
+  cmd.report.Check();
+  const ObjectModel object = LoadObject(cmd.object_path);
+  const CertifyBatchOptions options = CertifyOptions(cmd, object);
+  const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
+  std::vector<CloudSource> sources = CertifySources(cmd);
   const std::vector<CloudSource> all_sources = shard && !cmd.poses_path.empty() ? sources : std::vector<CloudSource>{};
   if (shard) sources = ShardSources(sources, *shard);
   if (!cmd.poses_path.empty()) return RunGivenPoses(cmd, object, options, sources, shard ? all_sources : sources);
@@ -309,25 +339,7 @@ int Run(const CertifyCommand& cmd) {
                  chosen.eps_oc, chosen.rule.c_str(), chosen.noise.eps_w, chosen.sampling.eps_s,
                  chosen.ToJson().c_str());
   }
-
-  std::ostringstream json_lines;
-  for (std::size_t i = 0; i < sources.size(); ++i) {
-    const CloudOutcome& outcome = result.outcomes[i];
-    const std::string& name = sources[i].name;
-    if (!outcome.processed()) {
-      std::cerr << "c3po certify: " << outcome.error << "\n";
-      if (cmd.json || !cmd.output_path.empty()) json_lines << CertifyJsonLine(sources[i], outcome) << "\n";
-      continue;
-    }
-    if (cmd.json || !cmd.output_path.empty()) json_lines << CertifyJsonLine(sources[i], outcome) << "\n";
-    if (!cmd.json) std::cout << HumanLine(name, outcome) << "\n";
-  }
-  if (!cmd.bop_csv_path.empty()) WriteFileAtomically(cmd.bop_csv_path, BopCsv(BopResultRows(sources, result)));
-  if (!cmd.output_path.empty()) {
-    WriteFileAtomically(cmd.output_path, json_lines.str());
-  } else if (cmd.json) {
-    std::cout << json_lines.str();
-  }
+  WriteCertifyResults(cmd, sources, result);
   const std::string settings = Settings(result.certificate, options, object);
   if (!cmd.json) {
     std::printf("certified %d/%zu (oc %d, nd %d, errors %d); %s%s\n", result.certified, sources.size(), result.oc,
