@@ -52,6 +52,66 @@ Plane TablePlane(const std::vector<SceneInstance>& instances, double tilt, doubl
   return plane;
 }
 
+// The image's depth from the rendered scene: the artefacts applied in metres
+// (their parameters are physical; their own random stream per image), then
+// depth-image units round(z_mm / depth_scale), 0 = no measurement; beyond 16
+// bits there is none either (counted in out_of_range).
+void WriteDepth(const BopSynthOptions& options, const SceneImage& scene, std::size_t index, SynthBopImage* image) {
+  const CameraIntrinsics& camera = options.camera;
+  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+  const double to_metres = options.units_to_mm / 1000.0;
+  std::vector<double> depth_m(pixels);
+  for (std::size_t p = 0; p < pixels; ++p) depth_m[p] = scene.depth[p] * to_metres;
+  if (options.artefacts.AnyDepth()) {
+    std::vector<int> blob_centres;
+    for (std::size_t p = 0; p < pixels; ++p) {
+      if (scene.label[p] != SceneImage::kBackground) blob_centres.push_back(static_cast<int>(p));
+    }
+    Rng artefact_rng = Rng::ForItem(options.seed ^ 0xa5f1c3e2d4b69788ULL, index);
+    image->artefacts =
+        ApplyDepthArtefacts(options.artefacts, camera.width, camera.height, blob_centres, &depth_m, artefact_rng);
+  }
+  image->depth.assign(pixels, 0);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    if (!(depth_m[p] > 0.0)) continue;
+    const double units = std::round(depth_m[p] * 1000.0 / options.depth_scale);
+    if (units > 65535.0) {
+      ++image->out_of_range;
+    } else {
+      image->depth[p] = static_cast<std::uint16_t>(units);
+    }
+  }
+}
+
+// Instance i of the scene as BOP records it: pose, masks, boxes, pixel counts
+// (valid: with a depth in `image`); its mask_visib bled by the artefacts
+// (counted in image->artefacts.bled).
+SynthBopInstance InstanceRecord(const BopSynthOptions& options, const SceneImage& scene, int i, int obj_id,
+                                const Pose& camera_from_model, SynthBopImage* image) {
+  const CameraIntrinsics& camera = options.camera;
+  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+  const std::vector<int>& silhouette = scene.silhouettes[static_cast<std::size_t>(i)];
+  SynthBopInstance instance;
+  instance.obj_id = obj_id;
+  instance.camera_from_model = camera_from_model;
+  instance.mask = MaskOf(silhouette, pixels);
+  instance.mask_visib = MaskOf(scene.VisiblePixels(i), pixels);
+  instance.bbox_obj = BoundingBox(instance.mask, camera.width);
+  instance.bbox_visib = BoundingBox(instance.mask_visib, camera.width);
+  instance.px_count_all = static_cast<long>(silhouette.size());
+  instance.px_count_visib = static_cast<long>(std::count(instance.mask_visib.begin(), instance.mask_visib.end(), 255));
+  for (const int p : silhouette) {
+    if (image->depth[static_cast<std::size_t>(p)] > 0) ++instance.px_count_valid;
+  }
+  instance.visib_fract = instance.px_count_all > 0 ? static_cast<double>(instance.px_count_visib) /
+                                                         static_cast<double>(instance.px_count_all)
+                                                   : 0.0;
+  if (options.artefacts.bleed > 0) {
+    image->artefacts.bled += BleedMask(camera.width, camera.height, options.artefacts.bleed, &instance.mask_visib);
+  }
+  return instance;
+}
+
 }  // namespace
 
 CameraIntrinsics YcbvCamera() {
@@ -154,7 +214,6 @@ std::unique_ptr<DepthRenderer> BopSceneGenerator::MakeRenderer() const {
 SynthBopImage BopSceneGenerator::Generate(std::size_t index, DepthRenderer* renderer) const {
   if (!renderer) throw std::invalid_argument("BopSceneGenerator: needs a renderer");
   const CameraIntrinsics& camera = options_.camera;
-  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
   Rng rng = Rng::ForItem(options_.seed, index);
   const Placed& target = objects_[0];
   for (int attempt = 1; attempt <= options_.max_attempts; ++attempt) {
@@ -210,53 +269,10 @@ SynthBopImage BopSceneGenerator::Generate(std::size_t index, DepthRenderer* rend
     image.width = camera.width;
     image.height = camera.height;
     image.attempts = attempt;
-    // Depth in metres for the artefacts (their parameters are physical).
-    const double to_metres = options_.units_to_mm / 1000.0;
-    std::vector<double> depth_m(pixels);
-    for (std::size_t p = 0; p < pixels; ++p) depth_m[p] = scene.depth[p] * to_metres;
-    if (options_.artefacts.AnyDepth()) {
-      std::vector<int> blob_centres;
-      for (std::size_t p = 0; p < pixels; ++p) {
-        if (scene.label[p] != SceneImage::kBackground) blob_centres.push_back(static_cast<int>(p));
-      }
-      Rng artefact_rng = Rng::ForItem(options_.seed ^ 0xa5f1c3e2d4b69788ULL, index);
-      image.artefacts = ApplyDepthArtefacts(options_.artefacts, camera.width, camera.height,
-                                            blob_centres, &depth_m, artefact_rng);
-    }
-    // Depth-image units: round(z_mm / depth_scale); beyond 16 bits = no measurement.
-    image.depth.assign(pixels, 0);
-    for (std::size_t p = 0; p < pixels; ++p) {
-      if (!(depth_m[p] > 0.0)) continue;
-      const double units = std::round(depth_m[p] * 1000.0 / options_.depth_scale);
-      if (units > 65535.0) {
-        ++image.out_of_range;
-      } else {
-        image.depth[p] = static_cast<std::uint16_t>(units);
-      }
-    }
+    WriteDepth(options_, scene, index, &image);
     for (std::size_t i = 0; i < instances.size(); ++i) {
-      SynthBopInstance instance;
-      instance.obj_id = placed[i]->object.obj_id;
-      instance.camera_from_model = instances[i].camera_from_model;
-      instance.mask = MaskOf(scene.silhouettes[i], pixels);
-      instance.mask_visib = MaskOf(scene.VisiblePixels(static_cast<int>(i)), pixels);
-      instance.bbox_obj = BoundingBox(instance.mask, camera.width);
-      instance.bbox_visib = BoundingBox(instance.mask_visib, camera.width);
-      instance.px_count_all = static_cast<long>(scene.silhouettes[i].size());
-      instance.px_count_visib =
-          static_cast<long>(std::count(instance.mask_visib.begin(), instance.mask_visib.end(), 255));
-      for (const int p : scene.silhouettes[i]) {
-        if (image.depth[static_cast<std::size_t>(p)] > 0) ++instance.px_count_valid;
-      }
-      instance.visib_fract = instance.px_count_all > 0
-                                 ? static_cast<double>(instance.px_count_visib) /
-                                       static_cast<double>(instance.px_count_all)
-                                 : 0.0;
-      if (options_.artefacts.bleed > 0) {
-        image.artefacts.bled +=
-            BleedMask(camera.width, camera.height, options_.artefacts.bleed, &instance.mask_visib);
-      }
-      image.instances.push_back(std::move(instance));
+      image.instances.push_back(InstanceRecord(options_, scene, static_cast<int>(i), placed[i]->object.obj_id,
+                                               instances[i].camera_from_model, &image));
     }
     return image;
   }
