@@ -55,6 +55,21 @@ const std::vector<CommandEntry>& Commands() {
   return commands;
 }
 
+// A command-line error as one line, named like the run-time errors ("c3po certify: ..."); where the
+// command line itself was wrong (not a value a check refused, e.g. an unwritable --report path),
+// also where to look. Scripts read the first line of stderr.
+std::string OneLineParseError(const CLI::App* app, const CLI::Error& error) {
+  std::string command = "c3po";
+  for (const CLI::App* sub = app; sub != nullptr;) {
+    const std::vector<CLI::App*> parsed = sub->get_subcommands();
+    if (parsed.empty()) break;
+    sub = parsed.front();
+    command += " " + sub->get_name();
+  }
+  const bool value_refused = dynamic_cast<const CLI::ValidationError*>(&error) != nullptr;
+  return command + ": " + error.what() + (value_refused ? "" : " (" + command + " --help lists the options)") + "\n";
+}
+
 std::string DetectorList() {
   std::string text = "Detectors:\n";
   for (const auto& info : c3po::ListDetectors()) {
@@ -73,6 +88,7 @@ int main(int argc, char** argv) {
                                           std::to_string(C3PO_BUILD_PLUGIN_ABI_VERSION) + ")");
   app.require_subcommand(1);
   app.footer(DetectorList());
+  app.failure_message(OneLineParseError);
 
   std::vector<std::pair<CLI::App*, RunFunction>> runners;
   for (const auto& entry : Commands()) {

@@ -2,7 +2,7 @@
 # Drives the c3po CLI with a corpus of bad inputs (issue 7) and checks, for
 # each case: the exit status (2 = bad input; 1 = "not certified" allowed where
 # the input is valid but hopeless), a status < 128 (no crash/core dump), one
-# stderr line naming the offending file, no (partial) output file, and the
+# stderr line ("c3po COMMAND: ...") naming the offending file, no (partial) output file, and the
 # inputs unchanged (sha256 before/after). Prints a table; exits 1 if any fails.
 # Usage: bad_inputs.sh C3PO_BIN SOURCE_DIR WORK_DIR
 # ctest: robustness_bad_inputs (label robustness).
@@ -44,6 +44,9 @@ check() {
   local naming; naming=$(grep -c -F "$named" "$name.err")
   if [ "$status" -eq 2 ] && [ "$naming" -ne 1 ]; then
     problems+="$naming stderr lines name $named; "
+  fi
+  if [ "$status" -eq 2 ] && { [ "$(wc -l < "$name.err")" -ne 1 ] || ! grep -q '^c3po' "$name.err"; }; then
+    problems+="stderr is not one line 'c3po COMMAND: ...'; "
   fi
   local message; message=$(grep -m1 -F "$named" "$name.err" || tail -1 "$name.out")
   if [ -z "$problems" ]; then ok=yes; else ok=NO; failures=$((failures + 1)); fi
