@@ -70,6 +70,13 @@ std::string OneLineParseError(const CLI::App* app, const CLI::Error& error) {
   return command + ": " + error.what() + (value_refused ? "" : " (" + command + " --help lists the options)") + "\n";
 }
 
+bool IsCommand(const std::string& name) {
+  for (const auto& entry : Commands()) {
+    if (name == entry.name) return true;
+  }
+  return false;
+}
+
 std::string DetectorList() {
   std::string text = "Detectors:\n";
   for (const auto& info : c3po::ListDetectors()) {
@@ -97,6 +104,10 @@ int main(int argc, char** argv) {
     runners.emplace_back(command, entry.setup(*command));
   }
 
+  if (argc > 1 && argv[1][0] != '-' && !IsCommand(argv[1])) {
+    std::cerr << "c3po: unknown command '" << argv[1] << "' (c3po --help lists the commands)\n";
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

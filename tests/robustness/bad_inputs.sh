@@ -41,14 +41,14 @@ check() {
       problems+="temporary file left in $dir; "
     fi
   fi
-  local naming; naming=$(grep -c -F "$named" "$name.err")
+  local naming; naming=$(grep -c -F -- "$named" "$name.err")
   if [ "$status" -eq 2 ] && [ "$naming" -ne 1 ]; then
     problems+="$naming stderr lines name $named; "
   fi
   if [ "$status" -eq 2 ] && { [ "$(wc -l < "$name.err")" -ne 1 ] || ! grep -q '^c3po' "$name.err"; }; then
     problems+="stderr is not one line 'c3po COMMAND: ...'; "
   fi
-  local message; message=$(grep -m1 -F "$named" "$name.err" || tail -1 "$name.out")
+  local message; message=$(grep -m1 -F -- "$named" "$name.err" || tail -1 "$name.out")
   if [ -z "$problems" ]; then ok=yes; else ok=NO; failures=$((failures + 1)); fi
   printf '%-26s %-6s %-4s %4ss %s\n' "$name" "$status" "$ok" "$((SECONDS - start))" "${message:0:140}"
   [ -z "$problems" ] || printf '%-26s        -> %s\n' "" "$problems"
@@ -273,6 +273,10 @@ check eval_samples_unwritable "2" blocker/e.jsonl blocker sim -- "$C3PO" eval "$
 check bench_json_unwritable "2" blocker/b.json blocker sim -- "$C3PO" bench corrector "$CUBE" --data sim --json blocker/b.json
 check annotate_html_unwritable "2" blocker/a.html blocker cube.obj -- "$C3PO" annotate cube.obj --auto 3 -o a.json --html blocker/a.html
 check indicators_output_unwritable "2" blocker/i.json blocker cube.json -- "$C3PO" indicators "$CUBE" -o blocker/i.json
+# The command line itself: one line too, named like the run-time errors.
+check unknown_command "2" - "'certifi'" cube.json -- "$C3PO" certifi "$CUBE"
+check unknown_option "2" - "--frobnicate" cube.json -- "$C3PO" certify "$CUBE" --detector svd --frobnicate one_point.xyz
+check missing_object "2" - "object is required" cube.json -- "$C3PO" certify --detector svd
 [ ! -e a.json ] || { echo "annotate wrote a.json although its --html could not be written"; failures=$((failures + 1)); }
 for name in certify_output_unwritable certify_report_unwritable certify_csv_unwritable eval_json_unwritable \
             eval_samples_unwritable bench_json_unwritable; do
