@@ -140,76 +140,111 @@ DepthImage DepthFromPng(const Image& image, double depth_scale) {
   return depth;
 }
 
-DepthImage ParseNpyDepth(const std::string& bytes, const std::string& name) {
+namespace {
+
+// What a .npy header says of a depth image (format 1.0-3.0: magic, version, header length, a Python dict).
+struct NpyLayout {
+  int item_size = 0;           // 4 ('<f4') or 8 ('<f8')
+  bool column_major = false;   // fortran_order
+  std::size_t height = 0, width = 0;
+  std::size_t data_offset = 0;
+};
+
+// The header's dict text; `offset` receives where it starts.
+std::string NpyHeaderText(const std::string& bytes, const std::string& name, std::size_t* offset) {
   static const char kMagic[] = "\x93NUMPY";
   if (bytes.size() < 10 || bytes.compare(0, 6, kMagic, 6) != 0) throw InputError(name, "not a .npy file (bad magic)");
   const int major = static_cast<unsigned char>(bytes[6]);
-  std::size_t header_len = 0, offset = 0;
+  const auto byte = [&bytes](std::size_t i) { return static_cast<std::size_t>(static_cast<unsigned char>(bytes[i])); };
+  std::size_t header_len = 0;
   if (major == 1) {
-    header_len = static_cast<unsigned char>(bytes[8]) | (static_cast<std::size_t>(static_cast<unsigned char>(bytes[9])) << 8);
-    offset = 10;
+    header_len = byte(8) | (byte(9) << 8);
+    *offset = 10;
   } else if (major == 2 || major == 3) {
     if (bytes.size() < 12) throw InputError(name, "truncated .npy header");
-    for (int i = 0; i < 4; ++i) header_len |= static_cast<std::size_t>(static_cast<unsigned char>(bytes[8 + i])) << (8 * i);
-    offset = 12;
+    for (int i = 0; i < 4; ++i) header_len |= byte(8 + i) << (8 * i);
+    *offset = 12;
   } else {
     throw InputError(name, ".npy version " + std::to_string(major) + " is not supported");
   }
-  if (header_len > 65536 || offset + header_len > bytes.size()) throw InputError(name, "truncated .npy header");
-  const std::string header = bytes.substr(offset, header_len);
-  auto value_of = [&](const std::string& key) -> std::string {
-    const std::size_t at = header.find("'" + key + "'");
-    if (at == std::string::npos) throw InputError(name, ".npy header: '" + key + "' missing");
-    std::size_t colon = header.find(':', at);
-    if (colon == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
-    std::size_t start = header.find_first_not_of(' ', colon + 1);
-    if (start == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
-    std::size_t end = header[start] == '(' ? header.find(')', start) : header.find_first_of(",}", start);
-    if (end == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
-    return header.substr(start, end - start + (header[start] == '(' ? 1 : 0));
-  };
-  const std::string descr = value_of("descr");
-  int item_size = 0;
-  if (descr == "'<f4'") item_size = 4;
-  else if (descr == "'<f8'") item_size = 8;
-  else throw InputError(name, ".npy dtype " + descr.substr(0, 20) + " is not float32/float64 little-endian ('<f4', '<f8')");
-  const std::string fortran = value_of("fortran_order");
-  if (fortran != "False" && fortran != "True") throw InputError(name, ".npy header: fortran_order must be True or False");
-  const std::string shape = value_of("shape");   // "(H, W)"
+  if (header_len > 65536 || *offset + header_len > bytes.size()) throw InputError(name, "truncated .npy header");
+  return bytes.substr(*offset, header_len);
+}
+
+// The value of 'key' in the header's dict, as written (a tuple with its parentheses).
+std::string NpyHeaderValue(const std::string& header, const std::string& key, const std::string& name) {
+  const std::size_t at = header.find("'" + key + "'");
+  if (at == std::string::npos) throw InputError(name, ".npy header: '" + key + "' missing");
+  const std::size_t colon = header.find(':', at);
+  if (colon == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
+  const std::size_t start = header.find_first_not_of(' ', colon + 1);
+  if (start == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
+  const bool tuple = header[start] == '(';
+  const std::size_t end = tuple ? header.find(')', start) : header.find_first_of(",}", start);
+  if (end == std::string::npos) throw InputError(name, ".npy header: malformed '" + key + "'");
+  return header.substr(start, end - start + (tuple ? 1 : 0));
+}
+
+// "(H, W)" -> {H, W}: non-negative integers of at most 9 digits, a trailing comma allowed.
+std::vector<long long> NpyShape(const std::string& shape, const std::string& name) {
   if (shape.size() < 2 || shape.front() != '(' || shape.back() != ')') {
     throw InputError(name, ".npy header: shape must be a tuple (H, W)");
   }
   std::vector<long long> dims;
-  {
-    std::string inner = shape.substr(1, shape.size() - 2);
-    std::stringstream stream(inner);
-    std::string item;
-    while (std::getline(stream, item, ',')) {
-      const std::size_t first = item.find_first_not_of(' ');
-      if (first == std::string::npos) continue;   // trailing comma
-      item = item.substr(first, item.find_last_not_of(' ') - first + 1);
-      if (item.empty() || item.size() > 9 || item.find_first_not_of("0123456789") != std::string::npos) {
-        throw InputError(name, ".npy header: bad shape " + shape.substr(0, 40));
-      }
-      dims.push_back(std::stoll(item));
+  std::stringstream stream(shape.substr(1, shape.size() - 2));
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    const std::size_t first = item.find_first_not_of(' ');
+    if (first == std::string::npos) continue;   // trailing comma
+    item = item.substr(first, item.find_last_not_of(' ') - first + 1);
+    if (item.empty() || item.size() > 9 || item.find_first_not_of("0123456789") != std::string::npos) {
+      throw InputError(name, ".npy header: bad shape " + shape.substr(0, 40));
     }
+    dims.push_back(std::stoll(item));
   }
+  return dims;
+}
+
+NpyLayout ParseNpyLayout(const std::string& bytes, const std::string& name) {
+  NpyLayout layout;
+  std::size_t offset = 0;
+  const std::string header = NpyHeaderText(bytes, name, &offset);
+  const std::string descr = NpyHeaderValue(header, "descr", name);
+  if (descr == "'<f4'") layout.item_size = 4;
+  else if (descr == "'<f8'") layout.item_size = 8;
+  else throw InputError(name, ".npy dtype " + descr.substr(0, 20) +
+                              " is not float32/float64 little-endian ('<f4', '<f8')");
+  const std::string fortran = NpyHeaderValue(header, "fortran_order", name);
+  if (fortran != "False" && fortran != "True") {
+    throw InputError(name, ".npy header: fortran_order must be True or False");
+  }
+  layout.column_major = fortran == "True";
+  const std::string shape = NpyHeaderValue(header, "shape", name);
+  const std::vector<long long> dims = NpyShape(shape, name);
   if (dims.size() != 2) throw InputError(name, ".npy depth must have shape (H, W), not " + shape.substr(0, 40));
   if (dims[0] <= 0 || dims[1] <= 0) throw InputError(name, ".npy depth of zero size");
-  const std::size_t height = static_cast<std::size_t>(dims[0]), width = static_cast<std::size_t>(dims[1]);
-  if (width * height > kMaxImagePixels) throw InputError(name, ".npy depth larger than the image limit");
-  const std::size_t data_offset = offset + header_len;
-  const std::size_t expected = width * height * static_cast<std::size_t>(item_size);
-  if (bytes.size() - data_offset != expected) {
-    throw InputError(name, ".npy data holds " + std::to_string(bytes.size() - data_offset) + " bytes, shape needs " +
-                               std::to_string(expected));
+  layout.height = static_cast<std::size_t>(dims[0]);
+  layout.width = static_cast<std::size_t>(dims[1]);
+  if (layout.width * layout.height > kMaxImagePixels) throw InputError(name, ".npy depth larger than the image limit");
+  layout.data_offset = offset + header.size();
+  return layout;
+}
+
+}  // namespace
+
+DepthImage ParseNpyDepth(const std::string& bytes, const std::string& name) {
+  const NpyLayout layout = ParseNpyLayout(bytes, name);
+  const std::size_t count = layout.width * layout.height;
+  const std::size_t expected = count * static_cast<std::size_t>(layout.item_size);
+  if (bytes.size() - layout.data_offset != expected) {
+    throw InputError(name, ".npy data holds " + std::to_string(bytes.size() - layout.data_offset) +
+                               " bytes, shape needs " + std::to_string(expected));
   }
-  DepthImage depth{static_cast<int>(width), static_cast<int>(height), std::vector<float>(width * height)};
-  const char* data = bytes.data() + data_offset;
-  const bool column_major = fortran == "True";
-  for (std::size_t i = 0; i < width * height; ++i) {
+  DepthImage depth{static_cast<int>(layout.width), static_cast<int>(layout.height), std::vector<float>(count)};
+  const char* data = bytes.data() + layout.data_offset;
+  for (std::size_t i = 0; i < count; ++i) {
     double value;
-    if (item_size == 4) {
+    if (layout.item_size == 4) {
       float f;
       std::memcpy(&f, data + 4 * i, 4);
       value = f;
@@ -218,7 +253,7 @@ DepthImage ParseNpyDepth(const std::string& bytes, const std::string& name) {
     }
     if (std::isinf(value) || value < 0.0) throw InputError(name, "negative or infinite depth in .npy");
     if (std::isnan(value)) value = 0.0;
-    const std::size_t target = column_major ? (i % height) * width + i / height : i;
+    const std::size_t target = layout.column_major ? (i % layout.height) * layout.width + i / layout.height : i;
     depth.z[target] = static_cast<float>(value);
   }
   return depth;
