@@ -315,3 +315,21 @@ TEST_CASE("IsClosedOutward rejects open, inverted and inconsistent meshes") {
   CHECK(c3po::IsClosedOutward(split));
   CHECK_FALSE(c3po::IsClosedOutward(c3po::Mesh{}));
 }
+
+TEST_CASE("IsClosedOutward leaves out zero-thickness fins, not repeated triangles") {
+  const c3po::Mesh box = c3po::MakeCuboid({0, 0, 0}, {1, 2, 3}, 0.5);
+  const auto with_extra = [&box](std::vector<Eigen::Vector3i> extra) {
+    c3po::Mesh mesh = box;
+    const Eigen::Index n = box.triangles.cols();
+    mesh.triangles.conservativeResize(3, n + static_cast<Eigen::Index>(extra.size()));
+    for (std::size_t k = 0; k < extra.size(); ++k) mesh.triangles.col(n + static_cast<Eigen::Index>(k)) = extra[k];
+    return mesh;
+  };
+  // A fin inside the box: a triangle over its diagonal and the reversed copy (drawn either way).
+  const Eigen::Vector3i diagonal(box.triangles(0, 0), box.triangles(1, 0), box.triangles(1, 6));
+  CHECK(c3po::IsClosedOutward(with_extra({diagonal, Eigen::Vector3i(diagonal(0), diagonal(2), diagonal(1))})));
+  // A face repeated with the same winding: its directed edges occur twice, so the rule refuses it.
+  const Eigen::Vector3i face = box.triangles.col(4);
+  CHECK_FALSE(c3po::IsClosedOutward(with_extra({face})));
+  CHECK_FALSE(c3po::IsClosedOutward(with_extra({face, face, Eigen::Vector3i(face(0), face(2), face(1))})));
+}

@@ -102,10 +102,10 @@ void DepthRenderer::ClearRectangle() {
   rect_u1_ = rect_v1_ = -1;
 }
 
-bool IsClosedOutward(const Mesh& mesh) {
-  if (mesh.empty()) return false;
-  // Vertices are identified by position (loaders split vertices at texture
-  // seams); zero-area triangles are never drawn and are skipped.
+namespace {
+
+// One id per vertex position (loaders split vertices at texture seams).
+std::vector<std::uint32_t> PositionIds(const Mesh& mesh) {
   std::vector<int> order(static_cast<std::size_t>(mesh.vertices.cols()));
   std::iota(order.begin(), order.end(), 0);
   const auto less = [&](int i, int j) {
@@ -113,28 +113,30 @@ bool IsClosedOutward(const Mesh& mesh) {
     return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
   };
   std::sort(order.begin(), order.end(), less);
-  std::vector<std::uint32_t> canonical(order.size());
+  std::vector<std::uint32_t> ids(order.size());
   for (std::size_t k = 0; k < order.size(); ++k) {
     const bool same = k > 0 && !less(order[k - 1], order[k]);
-    canonical[static_cast<std::size_t>(order[k])] =
-        same ? canonical[static_cast<std::size_t>(order[k - 1])] : static_cast<std::uint32_t>(k);
+    ids[static_cast<std::size_t>(order[k])] =
+        same ? ids[static_cast<std::size_t>(order[k - 1])] : static_cast<std::uint32_t>(k);
   }
-  // Triangles by sorted vertex ids and winding; a triangle coincident with a
-  // reversed copy of itself (a zero-thickness fin) is drawn either way and is
-  // left out, like zero-area triangles.
-  struct Face {
-    std::array<std::uint32_t, 3> sorted;
-    bool even;   // winding parity relative to the sorted order
-    std::array<std::uint32_t, 3> id;
-    bool operator<(const Face& o) const {
-      return sorted != o.sorted ? sorted < o.sorted : even < o.even;
-    }
-  };
-  std::vector<Face> faces;
+  return ids;
+}
+
+// A triangle by its position ids and winding.
+struct WoundFace {
+  std::array<std::uint32_t, 3> sorted;
+  bool even;   // winding parity relative to the sorted order
+  std::array<std::uint32_t, 3> id;
+  bool operator<(const WoundFace& o) const { return sorted != o.sorted ? sorted < o.sorted : even < o.even; }
+};
+
+// The triangles that are drawn (three distinct positions, non-zero area), sorted.
+std::vector<WoundFace> DrawnFaces(const Mesh& mesh, const std::vector<std::uint32_t>& position_ids) {
+  std::vector<WoundFace> faces;
   for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
-    Face face;
+    WoundFace face;
     for (int e = 0; e < 3; ++e) {
-      face.id[static_cast<std::size_t>(e)] = canonical[static_cast<std::size_t>(mesh.triangles(e, t))];
+      face.id[static_cast<std::size_t>(e)] = position_ids[static_cast<std::size_t>(mesh.triangles(e, t))];
     }
     const auto& id = face.id;
     if (id[0] == id[1] || id[1] == id[2] || id[0] == id[2]) continue;
@@ -153,15 +155,20 @@ bool IsClosedOutward(const Mesh& mesh) {
     faces.push_back(face);
   }
   std::sort(faces.begin(), faces.end());
-  // Directed edges: closed and consistent iff every directed edge occurs once
-  // and its reverse occurs too.
+  return faces;
+}
+
+// The sorted faces' directed edges (from << 32 | to), sorted. A triangle
+// coincident with a reversed copy of itself (a zero-thickness fin) is drawn
+// either way and is left out, like zero-area triangles.
+std::vector<std::uint64_t> DirectedEdgesWithoutFins(const std::vector<WoundFace>& faces) {
   std::vector<std::uint64_t> edges;
   edges.reserve(faces.size() * 3);
   for (std::size_t f = 0; f < faces.size(); ++f) {
-    const bool fin = (f + 1 < faces.size() && faces[f + 1].sorted == faces[f].sorted) ||
-                     (f > 0 && faces[f - 1].sorted == faces[f].sorted);
-    if (fin && ((f + 1 < faces.size() && faces[f + 1].even != faces[f].even) ||
-                (f > 0 && faces[f - 1].even != faces[f].even))) {
+    const bool next_same = f + 1 < faces.size() && faces[f + 1].sorted == faces[f].sorted;
+    const bool previous_same = f > 0 && faces[f - 1].sorted == faces[f].sorted;
+    if ((next_same && faces[f + 1].even != faces[f].even) ||
+        (previous_same && faces[f - 1].even != faces[f].even)) {
       continue;
     }
     const auto& id = faces[f].id;
@@ -170,18 +177,36 @@ bool IsClosedOutward(const Mesh& mesh) {
     }
   }
   std::sort(edges.begin(), edges.end());
-  if (std::adjacent_find(edges.begin(), edges.end()) != edges.end()) return false;
-  for (const std::uint64_t edge : edges) {
+  return edges;
+}
+
+// Closed and consistently wound iff every directed edge occurs once and its reverse occurs too.
+bool EveryEdgeOnceEachWay(const std::vector<std::uint64_t>& sorted_edges) {
+  if (std::adjacent_find(sorted_edges.begin(), sorted_edges.end()) != sorted_edges.end()) return false;
+  for (const std::uint64_t edge : sorted_edges) {
     const std::uint64_t reverse = (edge << 32) | (edge >> 32);
-    if (!std::binary_search(edges.begin(), edges.end(), reverse)) return false;
+    if (!std::binary_search(sorted_edges.begin(), sorted_edges.end(), reverse)) return false;
   }
+  return true;
+}
+
+// Six times the signed volume enclosed by the triangles (> 0: normals outward).
+double SixSignedVolume(const Mesh& mesh) {
   double six_volume = 0.0;
   for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
     const Eigen::Vector3d a = mesh.vertices.col(mesh.triangles(0, t));
     six_volume += a.dot(Eigen::Vector3d(mesh.vertices.col(mesh.triangles(1, t)))
                             .cross(Eigen::Vector3d(mesh.vertices.col(mesh.triangles(2, t)))));
   }
-  return six_volume > 0.0;
+  return six_volume;
+}
+
+}  // namespace
+
+bool IsClosedOutward(const Mesh& mesh) {
+  if (mesh.empty()) return false;
+  const std::vector<WoundFace> faces = DrawnFaces(mesh, PositionIds(mesh));
+  return EveryEdgeOnceEachWay(DirectedEdgesWithoutFins(faces)) && SixSignedVolume(mesh) > 0.0;
 }
 
 void DepthRenderer::Render(const Mesh& mesh, const Pose& camera_from_model,
