@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <set>
 #include <unordered_map>
 
@@ -30,7 +31,85 @@ std::string Id6(int id) {
   return text;
 }
 
+// Object ids present in the ground truth (listing with a dummy id reads every scene_gt.json).
+std::vector<int> ObjectIdsInGroundTruth(const std::string& bop_dir) {
+  std::set<int> ids;
+  BopOptions probe;
+  probe.obj_id = 0;
+  for (const std::string& scene : ListBopInstances(bop_dir, probe).scene_dirs) {
+    const std::string path = scene + "/scene_gt.json";
+    for (const auto& [im_id, list] : ParseSceneGt(ReadFileToString(path), path)) {
+      for (const auto& gt : list) ids.insert(gt.obj_id);
+    }
+  }
+  return {ids.begin(), ids.end()};
+}
+
+// Distance of every valid mask pixel's point (no preprocessing) to the ground-truth-posed model.
+std::unordered_map<std::int32_t, double> DistanceByPixel(const BopInstance& instance, const PointTree& model) {
+  SegmentOptions all;
+  all.erode_mask = 0;
+  all.max_relative_depth_step = 0.0;
+  all.support_plane_distance = 0.0;
+  all.max_points = 0;
+  const SegmentCloud every = LoadBopInstance(instance, all);
+  std::unordered_map<std::int32_t, double> distance;
+  if (every.cloud.cols() == 0) return distance;
+  Eigen::VectorXi indices;
+  Eigen::VectorXd squared;
+  model.NearestBatch(instance.ground_truth->InverseApply(every.cloud), &indices, &squared);
+  for (std::size_t i = 0; i < every.pixels.size(); ++i) {
+    distance[every.pixels[i]] = std::sqrt(squared(static_cast<Eigen::Index>(i)));
+  }
+  return distance;
+}
+
+// One variant's per-instance figures.
+struct VariantSamples {
+  std::vector<double> over5, over10, points, eroded, edges, planes;
+
+  void Add(const SegmentCloud& kept, const std::unordered_map<std::int32_t, double>& distance) {
+    std::size_t n5 = 0, n10 = 0;
+    for (std::int32_t pixel : kept.pixels) {
+      const double d = distance.at(pixel);
+      n5 += d > 0.005;
+      n10 += d > 0.010;
+    }
+    const double n = static_cast<double>(kept.pixels.size());
+    over5.push_back(n5 / n);
+    over10.push_back(n10 / n);
+    points.push_back(n);
+    eroded.push_back(static_cast<double>(kept.removed_by_erosion));
+    edges.push_back(static_cast<double>(kept.removed_by_discontinuity));
+    planes.push_back(static_cast<double>(kept.removed_by_plane));
+  }
+
+  SegmentBenchmarkRow Row(const SegmentOptions& options) const {
+    SegmentBenchmarkRow row;
+    row.options = options;
+    row.instances = static_cast<int>(over5.size());
+    if (row.instances == 0) return row;
+    const double count = row.instances;
+    const auto mean = [count](const std::vector<double>& v) {
+      return std::accumulate(v.begin(), v.end(), 0.0) / count;
+    };
+    const auto share_at_most = [count](const std::vector<double>& v, double limit) {
+      return std::count_if(v.begin(), v.end(), [limit](double f) { return f <= limit; }) / count;
+    };
+    row.mean_points = mean(points);
+    row.median_fraction_over_5mm = Median(over5);
+    row.worst_fraction_over_1cm = *std::max_element(over10.begin(), over10.end());
+    row.instances_at_most_5pc_over_1cm = share_at_most(over10, 0.05);
+    row.instances_at_most_2pc_over_5mm = share_at_most(over5, 0.02);
+    row.mean_removed_by_erosion = mean(eroded);
+    row.mean_removed_by_discontinuity = mean(edges);
+    row.mean_removed_by_plane = mean(planes);
+    return row;
+  }
+};
+
 }  // namespace
+
 
 void SegmentBenchmarkOptions::Check() const {
   if (bop_dir.empty()) throw InputError("c3po bench segments", "--bop DIR is required");
@@ -41,25 +120,10 @@ void SegmentBenchmarkOptions::Check() const {
 
 SegmentBenchmarkResult BenchmarkSegments(const SegmentBenchmarkOptions& options) {
   options.Check();
-  // Object ids present in the ground truth (listing with a dummy id reads every scene_gt.json).
-  std::vector<int> obj_ids = options.obj_ids;
-  if (obj_ids.empty()) {
-    std::set<int> ids;
-    BopOptions probe;
-    probe.obj_id = 0;
-    for (const std::string& scene : ListBopInstances(options.bop_dir, probe).scene_dirs) {
-      const std::string path = scene + "/scene_gt.json";
-      for (const auto& [im_id, list] : ParseSceneGt(ReadFileToString(path), path)) {
-        for (const auto& gt : list) ids.insert(gt.obj_id);
-      }
-    }
-    obj_ids.assign(ids.begin(), ids.end());
-  }
+  const std::vector<int> obj_ids =
+      options.obj_ids.empty() ? ObjectIdsInGroundTruth(options.bop_dir) : options.obj_ids;
   SegmentBenchmarkResult result;
-  const std::size_t variants = options.variants.size();
-  // Per variant, per instance: fractions and counts.
-  std::vector<std::vector<double>> over5(variants), over10(variants), points(variants), eroded(variants), edges(variants),
-      planes(variants);
+  std::vector<VariantSamples> samples(options.variants.size());
   for (int obj_id : obj_ids) {
     BopOptions bop;
     bop.obj_id = obj_id;
@@ -71,58 +135,17 @@ SegmentBenchmarkResult BenchmarkSegments(const SegmentBenchmarkOptions& options)
                                          std::sqrt(mesh.SurfaceArea() / options.model_sample));
     for (const BopInstance& instance : listed.instances) {
       ++result.instances;
-      SegmentOptions all;
-      all.erode_mask = 0;
-      all.max_relative_depth_step = 0.0;
-      all.support_plane_distance = 0.0;
-      all.max_points = 0;
-      const SegmentCloud every = LoadBopInstance(instance, all);
-      if (every.cloud.cols() == 0) continue;
-      // Distance of every valid mask pixel to the GT-posed model.
-      Eigen::VectorXi indices;
-      Eigen::VectorXd squared;
-      tree.NearestBatch(instance.ground_truth->InverseApply(every.cloud), &indices, &squared);
-      std::unordered_map<std::int32_t, double> distance;
-      for (std::size_t i = 0; i < every.pixels.size(); ++i) distance[every.pixels[i]] = std::sqrt(squared(static_cast<Eigen::Index>(i)));
-      for (std::size_t k = 0; k < variants; ++k) {
+      const std::unordered_map<std::int32_t, double> distance = DistanceByPixel(instance, tree);
+      if (distance.empty()) continue;
+      for (std::size_t k = 0; k < samples.size(); ++k) {
         SegmentOptions variant = options.variants[k];
         variant.max_points = 0;
         const SegmentCloud kept = LoadBopInstance(instance, variant);
-        if (kept.pixels.empty()) continue;
-        std::size_t n5 = 0, n10 = 0;
-        for (std::int32_t pixel : kept.pixels) {
-          const double d = distance.at(pixel);
-          n5 += d > 0.005;
-          n10 += d > 0.010;
-        }
-        const double n = static_cast<double>(kept.pixels.size());
-        over5[k].push_back(n5 / n);
-        over10[k].push_back(n10 / n);
-        points[k].push_back(n);
-        eroded[k].push_back(static_cast<double>(kept.removed_by_erosion));
-        edges[k].push_back(static_cast<double>(kept.removed_by_discontinuity));
-        planes[k].push_back(static_cast<double>(kept.removed_by_plane));
+        if (!kept.pixels.empty()) samples[k].Add(kept, distance);
       }
     }
   }
-  for (std::size_t k = 0; k < variants; ++k) {
-    SegmentBenchmarkRow row;
-    row.options = options.variants[k];
-    row.instances = static_cast<int>(over5[k].size());
-    if (row.instances > 0) {
-      const double count = row.instances;
-      auto mean = [&](const std::vector<double>& v) { double s = 0; for (double x : v) s += x; return s / count; };
-      row.mean_points = mean(points[k]);
-      row.median_fraction_over_5mm = Median(over5[k]);
-      row.worst_fraction_over_1cm = *std::max_element(over10[k].begin(), over10[k].end());
-      row.instances_at_most_5pc_over_1cm = std::count_if(over10[k].begin(), over10[k].end(), [](double f) { return f <= 0.05; }) / count;
-      row.instances_at_most_2pc_over_5mm = std::count_if(over5[k].begin(), over5[k].end(), [](double f) { return f <= 0.02; }) / count;
-      row.mean_removed_by_erosion = mean(eroded[k]);
-      row.mean_removed_by_discontinuity = mean(edges[k]);
-      row.mean_removed_by_plane = mean(planes[k]);
-    }
-    result.rows.push_back(row);
-  }
+  for (std::size_t k = 0; k < samples.size(); ++k) result.rows.push_back(samples[k].Row(options.variants[k]));
   return result;
 }
 
