@@ -113,8 +113,9 @@ void DeclareBopOptions(CLI::App& command, SynthBopCommand& o) {
   command.add_option("--bleed", o.bleed, bop + "dilate mask_visib by K pixels");
 }
 
-int RunSynthBop(const SynthCommonForBop& common, const SynthBopCommand& o) {
-  const ObjectModel object = LoadObject(common.object);
+namespace {
+
+BopSynthOptions MakeBopSynthOptions(const SynthCommonForBop& common, const SynthBopCommand& o) {
   BopSynthOptions options;
   options.count = common.count;
   options.images_per_scene = o.images_per_scene;
@@ -137,45 +138,45 @@ int RunSynthBop(const SynthCommonForBop& common, const SynthBopCommand& o) {
   options.artefacts = MakeArtefacts(o);
   options.seed = common.seed;
   options.Check();
+  return options;
+}
 
-  // Distractor meshes (metres, like the target's).
-  std::vector<Mesh> distractor_meshes;
-  std::vector<int> distractor_ids;
-  std::vector<std::string> distractor_files;
+// The --distractor objects' meshes (metres, like the target's), ids and files.
+struct DistractorObjects {
+  std::vector<Mesh> meshes;
+  std::vector<int> ids;
+  std::vector<std::string> files;
+
+  std::vector<SynthBopObject> Objects() const {
+    std::vector<SynthBopObject> objects;
+    for (std::size_t k = 0; k < meshes.size(); ++k) objects.push_back({&meshes[k], ids[k]});
+    return objects;
+  }
+};
+
+DistractorObjects LoadDistractors(const SynthBopCommand& o) {
+  DistractorObjects distractors;
   for (std::size_t k = 0; k < o.distractor_objects.size(); ++k) {
     const auto [file, id] = DistractorSpec(o.distractor_objects[k], o.obj_id + static_cast<int>(k) + 1);
-    const ObjectModel distractor = LoadObject(file);
-    distractor_meshes.push_back(distractor.mesh());
-    distractor_ids.push_back(id);
-    distractor_files.push_back(file);
+    distractors.meshes.push_back(LoadObject(file).mesh());
+    distractors.ids.push_back(id);
+    distractors.files.push_back(file);
   }
-  std::vector<SynthBopObject> distractors;
-  for (std::size_t k = 0; k < distractor_meshes.size(); ++k) {
-    distractors.push_back({&distractor_meshes[k], distractor_ids[k]});
-  }
-  if (!distractors.empty() && options.distractors == 0) {
-    throw InputError("--distractor", "given, but --distractors is 0 (how many per image?)");
-  }
-  const BopSceneGenerator generator({&object.mesh(), o.obj_id}, distractors, options, common.object);
+  return distractors;
+}
 
-  nlohmann::json provenance{{"object", common.object}, {"object_name", object.name()},
-                            {"units", object.spec().units}, {"obj_id", o.obj_id},
-                            {"distractor_objects", distractor_files},
-                            {"distractor_obj_ids", distractor_ids}};
-  ProgressBar progress("synth bop", static_cast<std::size_t>(options.count));
-  const BopSynthReport report = WriteBopDataset(
-      generator, common.output, provenance.dump(),
-      [&](std::size_t done, std::size_t) { progress.Update(done); });
-  progress.Finish();
+void PrintBopSynthReport(const BopSynthReport& report, const BopSceneGenerator& generator, const ObjectModel& object,
+                         const std::string& output, int obj_id) {
+  const BopSynthOptions& options = generator.options();
   std::printf("wrote %s: %zu images in %d scene(s) of %s (obj_id %d, d = %.4g m), %zu instances, "
               "pose %s, seed %llu\n",
-              common.output.c_str(), report.images, report.scenes, object.name().c_str(), o.obj_id,
+              output.c_str(), report.images, report.scenes, object.name().c_str(), obj_id,
               report.diameter, report.instances,
               ToString(options.pose.mode), static_cast<unsigned long long>(options.seed));
   std::printf("camera fx %.6g fy %.6g cx %.6g cy %.6g, %dx%d, depth_scale %.6g mm; object centre "
               "depth in [%.4g, %.4g] m\n",
               options.camera.fx, options.camera.fy, options.camera.cx, options.camera.cy,
-              options.camera.width, options.camera.height, generator.options().depth_scale,
+              options.camera.width, options.camera.height, options.depth_scale,
               report.distance_range.first, report.distance_range.second);
   std::printf("target: mean visib_fract %.3f, at least %ld visible pixels; %.2f draws per image\n",
               report.mean_target_visib_fract, report.target_visible_pixels_min, report.mean_attempts);
@@ -189,10 +190,33 @@ int RunSynthBop(const SynthCommonForBop& common, const SynthBopCommand& o) {
   }
   if (report.out_of_range > 0) {
     std::printf("%ld pixels beyond 65535 x %.4g mm written as 0 (no measurement)\n",
-                report.out_of_range, generator.options().depth_scale);
+                report.out_of_range, options.depth_scale);
   }
   std::printf("%.2f s (%.1f images/s)\n", report.seconds,
               report.seconds > 0 ? static_cast<double>(report.images) / report.seconds : 0.0);
+}
+
+}  // namespace
+
+int RunSynthBop(const SynthCommonForBop& common, const SynthBopCommand& o) {
+  const ObjectModel object = LoadObject(common.object);
+  const BopSynthOptions options = MakeBopSynthOptions(common, o);
+  const DistractorObjects distractors = LoadDistractors(o);
+  if (!distractors.meshes.empty() && options.distractors == 0) {
+    throw InputError("--distractor", "given, but --distractors is 0 (how many per image?)");
+  }
+  const BopSceneGenerator generator({&object.mesh(), o.obj_id}, distractors.Objects(), options, common.object);
+
+  nlohmann::json provenance{{"object", common.object}, {"object_name", object.name()},
+                            {"units", object.spec().units}, {"obj_id", o.obj_id},
+                            {"distractor_objects", distractors.files},
+                            {"distractor_obj_ids", distractors.ids}};
+  ProgressBar progress("synth bop", static_cast<std::size_t>(options.count));
+  const BopSynthReport report = WriteBopDataset(
+      generator, common.output, provenance.dump(),
+      [&](std::size_t done, std::size_t) { progress.Update(done); });
+  progress.Finish();
+  PrintBopSynthReport(report, generator, object, common.output, o.obj_id);
   return 0;
 }
 
