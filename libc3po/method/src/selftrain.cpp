@@ -383,6 +383,116 @@ bool Better(const ValidationFit& candidate, const ValidationFit& best, double re
   return candidate.residual_q50 < best.residual_q50;
 }
 
+// The held-out clouds (their frames and reference poses where given) and the training indices.
+struct HeldOut {
+  std::vector<PointSet> clouds;
+  std::vector<Pose> truth;
+  std::vector<DepthView> frames;
+  std::vector<int> train;
+};
+
+HeldOut SplitHeldOut(const std::vector<PointSet>& clouds, const SelfTrainOptions& options,
+                     const SelfTrainReference* reference, const std::vector<int>* groups,
+                     const std::vector<DepthView>* frames) {
+  // The split (by group when given): selftrain_inputs.hpp SplitValidation.
+  const ValidationSplit split =
+      SplitValidation(clouds.size(), groups, options.validation_fraction, options.seed, "selftrain");
+  HeldOut held_out;
+  for (const int k : split.validation) {
+    held_out.clouds.push_back(clouds[k]);
+    if (frames != nullptr) held_out.frames.push_back((*frames)[k]);
+    if (reference != nullptr) held_out.truth.push_back(reference->scene_from_model[k]);
+  }
+  held_out.train = split.train;
+  return held_out;
+}
+
+void CheckSelfTrainInputs(std::size_t clouds, const SelfTrainReference* reference, const std::vector<int>* groups,
+                          const std::vector<DepthView>* frames) {
+  if (clouds < 2) throw InputError("selftrain", "need at least 2 unlabelled clouds");
+  if (reference != nullptr && reference->scene_from_model.size() != clouds) {
+    throw std::invalid_argument("SelfTrain: reference poses must match the clouds");
+  }
+  if (groups != nullptr && groups->size() != clouds) {
+    throw std::invalid_argument("SelfTrain: groups must match the clouds");
+  }
+  if (frames != nullptr && frames->size() != clouds) {
+    throw std::invalid_argument("SelfTrain: frames must match the clouds");
+  }
+}
+
+// Where a run resumes: the epoch after the checkpoint's, and the count of epochs without a new best.
+struct ResumePoint {
+  int first_epoch = 1;
+  int stale = 0;
+};
+
+// Reads the checkpoint's state into `result` (epochs so far, best and initial fits, pseudo-label uses).
+ResumePoint ReadCheckpointState(const std::string& where, const std::string& text, std::size_t clouds,
+                                SelfTrainResult* result) {
+  ResumePoint resume;
+  try {
+    const json state = json::parse(text);
+    ReadStateField(state, "epoch", &resume.first_epoch, where);
+    resume.first_epoch += 1;
+    ReadStateField(state, "best_epoch", &result->best_epoch, where);
+    ReadStateField(state, "best_validation_percent_oc", &result->best_validation_percent_oc, where);
+    ReadStateField(state, "best_validation_detection_error", &result->best_validation_detection_error, where);
+    ReadStateField(state, "initial_validation_percent_oc", &result->initial_validation_percent_oc, where);
+    result->initial = FitFromJson(state.at("initial"), where);
+    result->best = FitFromJson(state.at("best"), where);
+    ReadStateField(state, "stale", &resume.stale, where);
+    for (const auto& log : state.at("logs")) result->epochs.push_back(LogFromJson(log, where));
+    const json uses = state.value("pseudo_label_uses", json::array());
+    if (uses.size() == clouds) {
+      for (std::size_t i = 0; i < uses.size(); ++i) {
+        result->pseudo_label_uses[i] =
+            static_cast<int>(IntegerInRange(uses[i], 0, std::numeric_limits<int>::max(), where, "pseudo_label_uses"));
+      }
+    }
+  } catch (const json::exception& e) {
+    throw InputError(where, std::string("corrupt self-training state: ") + e.what());
+  }
+  return resume;
+}
+
+void WriteCheckpoint(const SelfTrainOptions& options, const SelfTrainResult& result, int epoch, int stale,
+                     const std::vector<float>& best_weights, TrainableDetector& detector) {
+  json state = {{"epoch", epoch}, {"best_epoch", result.best_epoch},
+                {"best_validation_percent_oc", result.best_validation_percent_oc},
+                {"best_validation_detection_error", result.best_validation_detection_error},
+                {"initial_validation_percent_oc", result.initial_validation_percent_oc},
+                {"initial", FitJson(result.initial)}, {"best", FitJson(result.best)}, {"stale", stale},
+                {"logs", json::array()}, {"pseudo_label_uses", result.pseudo_label_uses}};
+  for (const auto& l : result.epochs) state["logs"].push_back(LogJson(l));
+  SaveWeights(options.checkpoint_path + ".best", best_weights);
+  detector.SaveCheckpoint(options.checkpoint_path, state.dump());
+}
+
+// The epoch's log line from its training statistics and the held-out fit.
+SelfTrainEpochLog EpochLog(int epoch, const EpochStats& stats, const ValidationFit& held_out) {
+  SelfTrainEpochLog log;
+  log.epoch = epoch;
+  log.train_percent_oc = stats.seen ? 100.0 * stats.certified / stats.seen : 0.0;
+  log.validation_percent_oc = held_out.percent_oc;
+  log.validation_percent_certified = held_out.percent_certified;
+  log.validation_detection_error = held_out.detection_error;
+  log.loss = stats.steps ? stats.loss_sum / stats.steps : 0.0;
+  log.mean_corrector_iterations = stats.seen ? stats.iterations / stats.seen : 0.0;
+  log.certified_samples = stats.certified;
+  log.ambiguous_skipped = stats.ambiguous;
+  log.symmetric_trained = stats.symmetric;
+  log.labelling_switched = stats.switched;
+  if (!stats.ambiguous_surface.empty()) log.ambiguous_surface_q50 = Quantile(stats.ambiguous_surface, 0.5);
+  log.validation_percent_identified = held_out.percent_identified;
+  log.validation_ambiguous = held_out.ambiguous;
+  log.validation_residual_q50 = held_out.residual_q50;
+  log.validation_residual_q90 = held_out.residual_q90;
+  log.validation_rotation_error_median = held_out.rotation_error_median;
+  log.validation_hausdorff_median = held_out.hausdorff_median;
+  return log;
+}
+
 }  // namespace
 
 SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
@@ -391,68 +501,24 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
                           bool resume, const SelfTrainReference* reference, const std::vector<int>* groups,
                           const std::vector<DepthView>* frames) {
   options.Check();
-  if (clouds.size() < 2) throw InputError("selftrain", "need at least 2 unlabelled clouds");
-  if (reference != nullptr && reference->scene_from_model.size() != clouds.size()) {
-    throw std::invalid_argument("SelfTrain: reference poses must match the clouds");
-  }
-  if (groups != nullptr && groups->size() != clouds.size()) {
-    throw std::invalid_argument("SelfTrain: groups must match the clouds");
-  }
-  if (frames != nullptr && frames->size() != clouds.size()) {
-    throw std::invalid_argument("SelfTrain: frames must match the clouds");
-  }
-  // The split (by group when given): selftrain_inputs.hpp SplitValidation.
-  const ValidationSplit split = SplitValidation(clouds.size(), groups, options.validation_fraction, options.seed, "selftrain");
-  std::vector<int> all = split.validation;
-  all.insert(all.end(), split.train.begin(), split.train.end());
-  const std::size_t validation_count = split.validation.size();
-  std::vector<PointSet> validation;
-  std::vector<Pose> validation_truth;
-  std::vector<DepthView> validation_frames;
-  for (std::size_t k = 0; k < validation_count; ++k) {
-    validation.push_back(clouds[all[k]]);
-    if (frames != nullptr) validation_frames.push_back((*frames)[all[k]]);
-    if (reference != nullptr) validation_truth.push_back(reference->scene_from_model[all[k]]);
-  }
-  const std::vector<Pose>* truth = reference != nullptr ? &validation_truth : nullptr;
-  const std::vector<int> train(all.begin() + static_cast<long>(validation_count), all.end());
+  CheckSelfTrainInputs(clouds.size(), reference, groups, frames);
+  const HeldOut held_out = SplitHeldOut(clouds, options, reference, groups, frames);
+  const std::vector<int>& train = held_out.train;
   const auto measure = [&] {
-    return MeasureValidationFit(object, validation, detector, options.pipeline, options.pseudo_labels, truth,
+    return MeasureValidationFit(object, held_out.clouds, detector, options.pipeline, options.pseudo_labels,
+                                reference != nullptr ? &held_out.truth : nullptr,
                                 reference != nullptr ? reference->symmetries : std::vector<Pose>{},
-                                frames != nullptr ? &validation_frames : nullptr);
+                                frames != nullptr ? &held_out.frames : nullptr);
   };
 
   SelfTrainResult result;
   result.pseudo_label_uses.assign(clouds.size(), 0);
   std::vector<float> best_weights;
-  int first_epoch = 1;
-  int stale = 0;   // epochs in a row without a new best
-  const std::string best_path = options.checkpoint_path + ".best";
+  ResumePoint at;
   if (resume && !options.checkpoint_path.empty() && std::filesystem::exists(options.checkpoint_path)) {
     const std::string& where = options.checkpoint_path;
-    try {
-      const json state = json::parse(detector.LoadCheckpoint(where));
-      ReadStateField(state, "epoch", &first_epoch, where);
-      first_epoch += 1;
-      ReadStateField(state, "best_epoch", &result.best_epoch, where);
-      ReadStateField(state, "best_validation_percent_oc", &result.best_validation_percent_oc, where);
-      ReadStateField(state, "best_validation_detection_error", &result.best_validation_detection_error, where);
-      ReadStateField(state, "initial_validation_percent_oc", &result.initial_validation_percent_oc, where);
-      result.initial = FitFromJson(state.at("initial"), where);
-      result.best = FitFromJson(state.at("best"), where);
-      ReadStateField(state, "stale", &stale, where);
-      for (const auto& log : state.at("logs")) result.epochs.push_back(LogFromJson(log, where));
-      const json uses = state.value("pseudo_label_uses", json::array());
-      if (uses.size() == clouds.size()) {
-        for (std::size_t i = 0; i < uses.size(); ++i) {
-          result.pseudo_label_uses[i] =
-              static_cast<int>(IntegerInRange(uses[i], 0, std::numeric_limits<int>::max(), where, "pseudo_label_uses"));
-        }
-      }
-    } catch (const json::exception& e) {
-      throw InputError(where, std::string("corrupt self-training state: ") + e.what());
-    }
-    best_weights = LoadWeights(best_path, detector.GetWeights().size());
+    at = ReadCheckpointState(where, detector.LoadCheckpoint(where), clouds.size(), &result);
+    best_weights = LoadWeights(options.checkpoint_path + ".best", detector.GetWeights().size());
   } else {
     result.initial = measure();
     result.best = result.initial;
@@ -464,7 +530,8 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
 
   const double eps_oc = options.pipeline.certificate.eps_oc;
   const std::size_t progress_total = train.size() * static_cast<std::size_t>(options.epochs);
-  for (int epoch = first_epoch; epoch <= options.epochs; ++epoch) {
+  int stale = at.stale;   // epochs in a row without a new best
+  for (int epoch = at.first_epoch; epoch <= options.epochs; ++epoch) {
     if (!result.epochs.empty() &&
         (result.best.percent_identified >= options.stop_at_percent_oc ||
          (options.patience > 0 && stale >= options.patience))) {
@@ -480,53 +547,25 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
       throw InputError("selftrain", "no training cloud was observably correct in the first epoch: nothing to "
                                     "learn from (check eps_oc, the object, or train the detector on sim data first)");
     }
-    const ValidationFit held_out = measure();
-    SelfTrainEpochLog log;
-    log.epoch = epoch;
-    log.train_percent_oc = stats.seen ? 100.0 * stats.certified / stats.seen : 0.0;
-    log.validation_percent_oc = held_out.percent_oc;
-    log.validation_percent_certified = held_out.percent_certified;
-    log.validation_detection_error = held_out.detection_error;
-    log.loss = stats.steps ? stats.loss_sum / stats.steps : 0.0;
-    log.mean_corrector_iterations = stats.seen ? stats.iterations / stats.seen : 0.0;
-    log.certified_samples = stats.certified;
-    log.ambiguous_skipped = stats.ambiguous;
-    log.symmetric_trained = stats.symmetric;
-    log.labelling_switched = stats.switched;
-    if (!stats.ambiguous_surface.empty()) log.ambiguous_surface_q50 = Quantile(stats.ambiguous_surface, 0.5);
-    log.validation_percent_identified = held_out.percent_identified;
-    log.validation_ambiguous = held_out.ambiguous;
-    log.validation_residual_q50 = held_out.residual_q50;
-    log.validation_residual_q90 = held_out.residual_q90;
-    log.validation_rotation_error_median = held_out.rotation_error_median;
-    log.validation_hausdorff_median = held_out.hausdorff_median;
-    if (Better(held_out, result.best, options.residual_tolerance, eps_oc)) {
-      result.best = held_out;
-      result.best_validation_percent_oc = held_out.percent_oc;
-      result.best_validation_detection_error = held_out.detection_error;
+    const ValidationFit fit = measure();
+    SelfTrainEpochLog log = EpochLog(epoch, stats, fit);
+    if (Better(fit, result.best, options.residual_tolerance, eps_oc)) {
+      result.best = fit;
+      result.best_validation_percent_oc = fit.percent_oc;
+      result.best_validation_detection_error = fit.detection_error;
       result.best_epoch = epoch;
       best_weights = detector.GetWeights();
       stale = 0;
     } else {
       ++stale;
-      if (Worse(held_out, result.best, options.residual_tolerance, eps_oc)) {
+      if (Worse(fit, result.best, options.residual_tolerance, eps_oc)) {
         detector.SetWeights(best_weights);   // roll back: continue from the best epoch
         log.rolled_back = true;
       }
     }
     log.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.epochs.push_back(log);
-    if (!options.checkpoint_path.empty()) {
-      json state = {{"epoch", epoch}, {"best_epoch", result.best_epoch},
-                    {"best_validation_percent_oc", result.best_validation_percent_oc},
-                    {"best_validation_detection_error", result.best_validation_detection_error},
-                    {"initial_validation_percent_oc", result.initial_validation_percent_oc},
-                    {"initial", FitJson(result.initial)}, {"best", FitJson(result.best)}, {"stale", stale},
-                    {"logs", json::array()}, {"pseudo_label_uses", result.pseudo_label_uses}};
-      for (const auto& l : result.epochs) state["logs"].push_back(LogJson(l));
-      SaveWeights(best_path, best_weights);
-      detector.SaveCheckpoint(options.checkpoint_path, state.dump());
-    }
+    if (!options.checkpoint_path.empty()) WriteCheckpoint(options, result, epoch, stale, best_weights, detector);
     if (on_epoch) on_epoch(log);
   }
   detector.SetWeights(best_weights);
