@@ -207,12 +207,8 @@ PointNetDetector::Evaluation PointNetDetector::Evaluate(const std::vector<Traini
   return evaluation;
 }
 
-PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train,
-                                        const std::vector<TrainingSample>& validation,
-                                        const PointNetTrainOptions& options,
-                                        const PointNetEpochCallback& on_epoch) {
-  options.Check();
-  Impl& impl = *impl_;
+static void CheckFitSamples(const PointNetDetector::Impl& impl, const std::vector<TrainingSample>& train,
+                            const std::vector<TrainingSample>& validation, const PointNetTrainOptions& options) {
   if (options.num_points != impl.architecture.num_points) {
     throw std::invalid_argument("options.num_points (" + std::to_string(options.num_points) +
                                 ") differs from the network's (" +
@@ -221,9 +217,105 @@ PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train
   for (const auto& s : train) CheckKeypointCount(s.keypoints, impl.identity.num_keypoints);
   for (const auto& s : validation) CheckKeypointCount(s.keypoints, impl.identity.num_keypoints);
   if (train.empty()) throw std::invalid_argument("Fit: no training samples");
+}
+
+// A batch ready for the network: the samples at order[begin, begin + count), each augmented and
+// prepared with its own seeded generator (so a batch does not depend on the threads).
+struct PreparedBatch {
+  tiny_dnn::tensor_t inputs, targets;
+  std::vector<tiny_dnn::tensor_t> symmetric_targets;
+};
+
+static PreparedBatch PrepareBatch(const PointNetDetector::Impl& impl, const std::vector<const TrainingSample*>& train,
+                                  const std::vector<std::size_t>& order, std::size_t begin, std::size_t count,
+                                  std::uint64_t epoch_seed, const pointnet::Augmentation& augmentation) {
+  PreparedBatch batch{tiny_dnn::tensor_t(count), tiny_dnn::tensor_t(count), std::vector<tiny_dnn::tensor_t>(count)};
+  const double scale = impl.identity.scale;
+  ParallelFor(0, static_cast<int>(count), [&](int i) {
+    const std::size_t position = begin + static_cast<std::size_t>(i);
+    Rng rng = Rng::ForItem(epoch_seed, position);
+    const TrainingSample& original = *train[order[position]];
+    const TrainingSample sample = augmentation.active() ? pointnet::Augment(original, augmentation, &rng) : original;
+    auto prepared = pointnet::PrepareCloud(sample.cloud, impl.architecture.num_points, scale, &rng);
+    const std::size_t s = static_cast<std::size_t>(i);
+    batch.targets[s] = pointnet::NormaliseKeypoints(sample.keypoints, prepared.centroid, scale);
+    for (const PointSet& labelling : sample.symmetric_keypoints) {
+      batch.symmetric_targets[s].push_back(pointnet::NormaliseKeypoints(labelling, prepared.centroid, scale));
+    }
+    batch.inputs[s] = std::move(prepared.points);
+  }, impl.threads);
+  return batch;
+}
+
+// One pass over the training samples in a seeded order; the epoch's log with its training loss
+// (metres squared) and switched labellings.
+static EpochLog TrainEpoch(PointNetDetector::Impl* impl, const std::vector<const TrainingSample*>& train, int epoch,
+                           const PointNetTrainOptions& options) {
+  const pointnet::Augmentation augmentation{options.rotate_about_camera_deg, options.point_dropout,
+                                            options.noise_sigma};
+  const std::uint64_t epoch_seed = EpochSeed(options.seed, epoch);
+  Rng shuffle_rng(epoch_seed);
+  const std::vector<std::size_t> order = Shuffled(train.size(), &shuffle_rng);
+  double loss_sum = 0.0;
+  int switched = 0;
+  for (std::size_t begin = 0; begin < order.size(); begin += static_cast<std::size_t>(options.batch)) {
+    HoldForInterruptAt(epoch, static_cast<long long>(begin / static_cast<std::size_t>(options.batch)));
+    ThrowIfInterrupted();
+    const std::size_t count = std::min(order.size() - begin, static_cast<std::size_t>(options.batch));
+    PreparedBatch batch = PrepareBatch(*impl, train, order, begin, count, epoch_seed, augmentation);
+    switched += ChooseNearestTargets(impl, batch.inputs, batch.symmetric_targets, &batch.targets);
+    loss_sum += StepOnPrepared(impl, batch.inputs, batch.targets) * static_cast<double>(count);
+  }
+  const double scale = impl->identity.scale;
+  EpochLog log;
+  log.epoch = epoch;
+  log.train_loss = loss_sum / static_cast<double>(order.size()) * scale * scale;
+  log.labellings_switched = switched;
+  return log;
+}
+
+// The model file's training record: the run's counts, options and best epoch.
+static std::string TrainingInfo(const std::string& before, const PointNetFitResult& result, int epochs_done,
+                                const PointNetTrainOptions& options) {
+  nlohmann::json info = nlohmann::json::parse(before);
+  info["epochs"] = epochs_done;
+  info["best_epoch"] = result.best_epoch;
+  if (std::isfinite(result.best_val_loss)) info["best_val_loss"] = result.best_val_loss;
+  info["train_samples"] = result.train_samples;
+  info["validation_samples"] = result.validation_samples;
+  info["optimizer"] = options.optimizer;
+  info["lr"] = options.lr;
+  info["batch"] = options.batch;
+  info["seed"] = options.seed;
+  info["augmentation"] = {{"rotate_about_camera_deg", options.rotate_about_camera_deg},
+                          {"point_dropout", options.point_dropout},
+                          {"noise_sigma", options.noise_sigma}};
+  return info.dump();
+}
+
+PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train,
+                                        const std::vector<TrainingSample>& validation,
+                                        const PointNetTrainOptions& options,
+                                        const PointNetEpochCallback& on_epoch) {
+  options.Check();
+  Impl& impl = *impl_;
+  CheckFitSamples(impl, train, validation, options);
   const Split split = SplitSamples(train, validation, options);
   std::vector<TrainingSample> validation_set;
   for (const auto* s : split.validation) validation_set.push_back(*s);
+  // Records an epoch's validation and keeps its weights when they are the best so far.
+  const auto validate = [&](EpochLog* log, Clock::time_point start, bool always_best) {
+    const Evaluation evaluation = Evaluate(validation_set);
+    log->val_loss = evaluation.loss;
+    log->val_keypoint_error = evaluation.keypoint_error;
+    log->best = always_best || validation_set.empty() || evaluation.loss < impl.progress.best_val_loss;
+    if (log->best) {
+      impl.progress.best_val_loss = validation_set.empty() ? std::nan("") : evaluation.loss;
+      impl.progress.best_epoch = log->epoch;
+      impl.progress.best_weights = impl.network->Weights();
+    }
+    log->seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  };
 
   if (!options.resume || impl.progress.epochs_done == 0) {
     impl.progress = PointNetProgress{};
@@ -238,65 +330,14 @@ PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train
     EpochLog log;
     log.epoch = 0;
     log.train_loss = Evaluate(train_set).loss;
-    const Evaluation evaluation = Evaluate(validation_set);
-    log.val_loss = evaluation.loss;
-    log.val_keypoint_error = evaluation.keypoint_error;
-    log.best = true;
-    impl.progress.best_val_loss = validation_set.empty() ? std::nan("") : evaluation.loss;
-    impl.progress.best_epoch = 0;
-    impl.progress.best_weights = impl.network->Weights();
-    log.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    validate(&log, start, true);
     impl.progress.history.push_back(log);
     if (on_epoch) on_epoch(log);
   }
-  const pointnet::Augmentation augmentation{options.rotate_about_camera_deg, options.point_dropout,
-                                            options.noise_sigma};
-  const double scale = impl.identity.scale;
-  const int num_points = impl.architecture.num_points;
-
   for (int epoch = impl.progress.epochs_done + 1; epoch <= options.epochs; ++epoch) {
     const auto start = Clock::now();
-    const std::uint64_t epoch_seed = EpochSeed(options.seed, epoch);
-    Rng shuffle_rng(epoch_seed);
-    const std::vector<std::size_t> order = Shuffled(split.train.size(), &shuffle_rng);
-    double loss_sum = 0.0;
-    int switched = 0;
-    for (std::size_t begin = 0; begin < order.size(); begin += static_cast<std::size_t>(options.batch)) {
-      HoldForInterruptAt(epoch, static_cast<long long>(begin / static_cast<std::size_t>(options.batch)));
-      ThrowIfInterrupted();
-      const std::size_t count = std::min(order.size() - begin, static_cast<std::size_t>(options.batch));
-      tiny_dnn::tensor_t inputs(count), targets(count);
-      std::vector<tiny_dnn::tensor_t> symmetric_targets(count);
-      ParallelFor(0, static_cast<int>(count), [&](int i) {
-        const std::size_t position = begin + static_cast<std::size_t>(i);
-        Rng rng = Rng::ForItem(epoch_seed, position);
-        const TrainingSample& original = *split.train[order[position]];
-        const TrainingSample sample = augmentation.active() ? pointnet::Augment(original, augmentation, &rng) : original;
-        auto prepared = pointnet::PrepareCloud(sample.cloud, num_points, scale, &rng);
-        const std::size_t s = static_cast<std::size_t>(i);
-        targets[s] = pointnet::NormaliseKeypoints(sample.keypoints, prepared.centroid, scale);
-        for (const PointSet& labelling : sample.symmetric_keypoints) {
-          symmetric_targets[s].push_back(pointnet::NormaliseKeypoints(labelling, prepared.centroid, scale));
-        }
-        inputs[s] = std::move(prepared.points);
-      }, impl.threads);
-      switched += ChooseNearestTargets(&impl, inputs, symmetric_targets, &targets);
-      loss_sum += StepOnPrepared(&impl, inputs, targets) * static_cast<double>(count);
-    }
-    EpochLog log;
-    log.epoch = epoch;
-    log.train_loss = loss_sum / static_cast<double>(order.size()) * scale * scale;
-    const Evaluation evaluation = Evaluate(validation_set);
-    log.val_loss = evaluation.loss;
-    log.val_keypoint_error = evaluation.keypoint_error;
-    log.best = validation_set.empty() || evaluation.loss < impl.progress.best_val_loss;
-    if (log.best) {
-      impl.progress.best_val_loss = validation_set.empty() ? std::nan("") : evaluation.loss;
-      impl.progress.best_epoch = epoch;
-      impl.progress.best_weights = impl.network->Weights();
-    }
-    log.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    log.labellings_switched = switched;
+    EpochLog log = TrainEpoch(&impl, split.train, epoch, options);
+    validate(&log, start, false);
     impl.progress.epochs_done = epoch;
     impl.progress.history.push_back(log);
     if (!options.checkpoint_path.empty()) SaveCheckpoint(options.checkpoint_path, "");
@@ -313,20 +354,7 @@ PointNetFitResult PointNetDetector::Fit(const std::vector<TrainingSample>& train
     impl.network->SetWeights(impl.progress.best_weights);
     impl.WeightsChanged();
   }
-  nlohmann::json info = nlohmann::json::parse(impl.training_info);
-  info["epochs"] = impl.progress.epochs_done;
-  info["best_epoch"] = result.best_epoch;
-  if (std::isfinite(result.best_val_loss)) info["best_val_loss"] = result.best_val_loss;
-  info["train_samples"] = result.train_samples;
-  info["validation_samples"] = result.validation_samples;
-  info["optimizer"] = options.optimizer;
-  info["lr"] = options.lr;
-  info["batch"] = options.batch;
-  info["seed"] = options.seed;
-  info["augmentation"] = {{"rotate_about_camera_deg", options.rotate_about_camera_deg},
-                          {"point_dropout", options.point_dropout},
-                          {"noise_sigma", options.noise_sigma}};
-  impl.training_info = info.dump();
+  impl.training_info = TrainingInfo(impl.training_info, result, impl.progress.epochs_done, options);
   return result;
 }
 
