@@ -141,62 +141,61 @@ std::string GivenPoseJsonLine(const CloudSource& source, const CloudOutcome& out
   return line + extra;
 }
 
-// c3po certify --poses: every hypothesis matched to a cloud is certified; per
-// instance the certified one with the best fit is chosen (given_poses.hpp).
-// With --shard, `clouds` is this shard's part of `all_clouds`: hypotheses
-// that match only sources of other shards are theirs, not unmatched.
-int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const CertifyBatchOptions& options,
-                  const std::vector<CloudSource>& clouds, const std::vector<CloudSource>& all_clouds) {
-  const std::vector<PoseHypothesis> poses = ReadPoseList(cmd.poses_path);
+// The hypotheses matched to this shard's clouds. With --shard, `clouds` is this shard's part of
+// `all_clouds`: hypotheses that match only sources of other shards are theirs, not unmatched
+// (counted in `other_shards`).
+GivenPoseSources MatchThisShard(const ObjectModel& object, const std::vector<CloudSource>& clouds,
+                                const std::vector<CloudSource>& all_clouds, const std::vector<PoseHypothesis>& poses,
+                                std::size_t* other_shards) {
   GivenPoseSources matched = MatchGivenPoses(object, clouds, poses);
-  std::size_t other_shards = 0;
-  if (clouds.size() != all_clouds.size()) {
-    const std::vector<std::size_t> unmatched_anywhere = MatchGivenPoses(object, all_clouds, poses).unmatched;
-    const std::vector<std::size_t> here = matched.unmatched;
-    matched.unmatched.clear();
-    for (std::size_t h : here) {
-      if (std::find(unmatched_anywhere.begin(), unmatched_anywhere.end(), h) != unmatched_anywhere.end()) {
-        matched.unmatched.push_back(h);
-      } else {
-        ++other_shards;
-      }
+  *other_shards = 0;
+  if (clouds.size() == all_clouds.size()) return matched;
+  const std::vector<std::size_t> unmatched_anywhere = MatchGivenPoses(object, all_clouds, poses).unmatched;
+  const std::vector<std::size_t> here = matched.unmatched;
+  matched.unmatched.clear();
+  for (std::size_t h : here) {
+    if (std::find(unmatched_anywhere.begin(), unmatched_anywhere.end(), h) != unmatched_anywhere.end()) {
+      matched.unmatched.push_back(h);
+    } else {
+      ++*other_shards;
     }
   }
+  return matched;
+}
+
+// One stderr line per unmatched hypothesis, one for those of other objects and one for other shards'.
+void ReportPosesNotCertified(const std::string& poses_path, const std::vector<PoseHypothesis>& poses,
+                             const GivenPoseSources& matched, std::size_t other_shards) {
   for (std::size_t h : matched.unmatched) {
     const PoseHypothesis& pose = poses[h];
-    std::cerr << "c3po certify: " << cmd.poses_path << ": line " << pose.line << ": "
-              << (pose.cloud.empty() ? "no BOP instance" + (pose.obj_id ? " of obj_id " + std::to_string(*pose.obj_id) : "") +
-                                           " in scene/image '" + PoseMatchKey(pose) + "'"
+    const std::string of_object = pose.obj_id ? " of obj_id " + std::to_string(*pose.obj_id) : "";
+    std::cerr << "c3po certify: " << poses_path << ": line " << pose.line << ": "
+              << (pose.cloud.empty() ? "no BOP instance" + of_object + " in scene/image '" + PoseMatchKey(pose) + "'"
                                      : "no cloud named '" + pose.cloud + "'")
               << " (unmatched)\n";
   }
   if (!matched.other_object.empty()) {
-    std::cerr << "c3po certify: " << cmd.poses_path << ": " << matched.other_object.size()
+    std::cerr << "c3po certify: " << poses_path << ": " << matched.other_object.size()
               << " line(s) for other obj_ids skipped (first: line " << poses[matched.other_object.front()].line
               << ", obj_id " << *poses[matched.other_object.front()].obj_id << ")\n";
   }
   if (other_shards > 0) {
-    std::cerr << "c3po certify: " << cmd.poses_path << ": " << other_shards << " line(s) for other shards skipped\n";
+    std::cerr << "c3po certify: " << poses_path << ": " << other_shards << " line(s) for other shards skipped\n";
   }
-  ProgressBar progress("certify", matched.sources.size());
-  const CertifyBatchResult result =
-      matched.sources.empty() ? CertifyBatchResult{}
-                              : CertifyBatch(object, matched.sources, nullptr, options,
-                                             [&](std::size_t done, std::size_t) { progress.Update(done); });
-  progress.Finish();
-  const std::vector<InstanceVerdict> verdicts = ChooseCertified(matched, poses, result);
-  std::vector<bool> chosen(matched.sources.size(), false);
-  for (const auto& v : verdicts) {
-    if (v.chosen) chosen[*v.chosen] = true;
-  }
+}
+
+// Per matched hypothesis its JSON line (and human line without --json), then an error line per
+// unmatched one; `errors` counts the hypotheses that could not be processed.
+std::string GivenPoseLines(const CertifyCommand& cmd, const GivenPoseSources& matched,
+                           const std::vector<PoseHypothesis>& poses, const CertifyBatchResult& result,
+                           const std::vector<bool>& chosen, int* errors) {
   std::ostringstream json_lines;
-  int errors = static_cast<int>(matched.unmatched.size());
   for (std::size_t s = 0; s < matched.sources.size(); ++s) {
     const CloudOutcome& outcome = result.outcomes[s];
     const PoseHypothesis& pose = poses[matched.hypothesis[s]];
     const std::string& name = matched.sources[s].name;
     if (!outcome.processed()) {
-      ++errors;
+      ++*errors;
       std::cerr << "c3po certify: " << outcome.error << "\n";
       if (cmd.json) json_lines << CertifyErrorJsonLine(name, outcome.error) << "\n";
       continue;
@@ -217,6 +216,30 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
                  << "\n";
     }
   }
+  return json_lines.str();
+}
+
+// c3po certify --poses: every hypothesis matched to a cloud is certified; per
+// instance the certified one with the best fit is chosen (given_poses.hpp).
+int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const CertifyBatchOptions& options,
+                  const std::vector<CloudSource>& clouds, const std::vector<CloudSource>& all_clouds) {
+  const std::vector<PoseHypothesis> poses = ReadPoseList(cmd.poses_path);
+  std::size_t other_shards = 0;
+  const GivenPoseSources matched = MatchThisShard(object, clouds, all_clouds, poses, &other_shards);
+  ReportPosesNotCertified(cmd.poses_path, poses, matched, other_shards);
+  ProgressBar progress("certify", matched.sources.size());
+  const CertifyBatchResult result =
+      matched.sources.empty() ? CertifyBatchResult{}
+                              : CertifyBatch(object, matched.sources, nullptr, options,
+                                             [&](std::size_t done, std::size_t) { progress.Update(done); });
+  progress.Finish();
+  const std::vector<InstanceVerdict> verdicts = ChooseCertified(matched, poses, result);
+  std::vector<bool> chosen(matched.sources.size(), false);
+  for (const auto& v : verdicts) {
+    if (v.chosen) chosen[*v.chosen] = true;
+  }
+  int errors = static_cast<int>(matched.unmatched.size());
+  const std::string json_lines = GivenPoseLines(cmd, matched, poses, result, chosen, &errors);
   if (!cmd.bop_csv_path.empty()) {
     std::vector<std::size_t> written;   // one row per instance: its chosen (else best-fitting) hypothesis
     for (const auto& v : verdicts) {
@@ -226,17 +249,18 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
   }
   WriteReportIfAsked(cmd, object, matched.sources, result, Settings(result.certificate, options, object));
   if (!cmd.output_path.empty()) {
-    WriteFileAtomically(cmd.output_path, json_lines.str());
+    WriteFileAtomically(cmd.output_path, json_lines);
   } else if (cmd.json) {
-    std::cout << json_lines.str();
+    std::cout << json_lines;
   }
   int instances_certified = 0;
   for (const auto& v : verdicts) instances_certified += v.chosen ? 1 : 0;
   if (!cmd.json) {
     for (const auto& v : verdicts) {
-      std::printf("%s: %s\n", clouds[v.instance].name.c_str(),
-                  v.chosen ? ("certified hypothesis: line " + std::to_string(poses[matched.hypothesis[*v.chosen]].line)).c_str()
-                           : "no certified hypothesis");
+      const std::string verdict =
+          v.chosen ? "certified hypothesis: line " + std::to_string(poses[matched.hypothesis[*v.chosen]].line)
+                   : "no certified hypothesis";
+      std::printf("%s: %s\n", clouds[v.instance].name.c_str(), verdict.c_str());
     }
     std::printf("instances with a certified pose %d/%zu (hypotheses %zu, unmatched %zu, errors %d; "
                 "%zu of %zu sources had no hypothesis)\n",
