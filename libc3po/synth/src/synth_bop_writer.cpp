@@ -123,6 +123,86 @@ void WriteUnsynced(const std::string& path, const std::string& bytes) {
   WriteFileAtomically(path, [&](std::ostream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); }, false);
 }
 
+// The scene folders 000000, 000001, ... with their image subfolders, inside the staged folder.
+void MakeSceneFolders(const StagedFolder& folder, const std::string& dir, int scenes) {
+  for (int s = 0; s < scenes; ++s) {
+    for (const char* sub : {"depth", "mask", "mask_visib"}) {
+      std::error_code ec;
+      fs::create_directories(folder.path() + "/" + Numbered(s) + "/" + sub, ec);
+      if (ec) throw InputError(dir, "cannot write: " + ec.message());
+    }
+  }
+}
+
+// Each scene's scene_camera.json, scene_gt.json and scene_gt_info.json from the images' records.
+void WriteSceneFiles(const StagedFolder& folder, int scenes, const std::vector<ImageRecord>& records) {
+  for (int s = 0; s < scenes; ++s) {
+    Json camera = Json::object(), gt = Json::object(), gt_info = Json::object();
+    for (const ImageRecord& record : records) {
+      if (record.scene_id != s) continue;
+      const std::string key = std::to_string(record.im_id);
+      camera[key] = record.camera;
+      gt[key] = record.gt;
+      gt_info[key] = record.gt_info;
+    }
+    const std::string scene = folder.path() + "/" + Numbered(s) + "/";
+    WriteUnsynced(scene + "scene_camera.json", DumpByKey(camera));
+    WriteUnsynced(scene + "scene_gt.json", DumpByKey(gt));
+    WriteUnsynced(scene + "scene_gt_info.json", DumpByKey(gt_info));
+  }
+}
+
+// The report's counts and means over the images' records.
+BopSynthReport ReportOf(const BopSceneGenerator& generator, int scenes, const std::vector<ImageRecord>& records) {
+  const std::size_t total = records.size();
+  BopSynthReport report;
+  report.images = total;
+  report.scenes = scenes;
+  report.distance_range = generator.distance_range();
+  report.diameter = generator.diameter();
+  report.target_visible_pixels_min = total > 0 ? records[0].target_visible_pixels : 0;
+  for (const ImageRecord& record : records) {
+    report.instances += record.instances;
+    report.mean_attempts += record.attempts;
+    report.mean_target_visib_fract += record.target_visib_fract;
+    report.target_visible_pixels_min = std::min(report.target_visible_pixels_min, record.target_visible_pixels);
+    report.flying += record.artefacts.flying;
+    report.dropped += record.artefacts.dropped;
+    report.bled += record.artefacts.bled;
+    report.out_of_range += record.out_of_range;
+  }
+  report.mean_attempts /= static_cast<double>(total);
+  report.mean_target_visib_fract /= static_cast<double>(total);
+  return report;
+}
+
+// synth_bop.json: how the dataset was made (options, camera, artefacts, the caller's provenance).
+Json DatasetInfo(const BopSceneGenerator& generator, std::size_t images, int scenes, const Json& provenance) {
+  const BopSynthOptions& options = generator.options();
+  const CameraIntrinsics& c = options.camera;
+  const DepthArtefactOptions& a = options.artefacts;
+  return Json{{"generator", "c3po synth --format bop"},
+              {"version", C3PO_VERSION},
+              {"images", images},
+              {"scenes", scenes},
+              {"images_per_scene", options.images_per_scene},
+              {"seed", options.seed},
+              {"pose", ToString(options.pose.mode)},
+              {"distance_range", {generator.distance_range().first, generator.distance_range().second}},
+              {"camera", {{"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx}, {"cy", c.cy},
+                          {"width", c.width}, {"height", c.height}}},
+              {"depth_scale", options.depth_scale},
+              {"units_to_mm", options.units_to_mm},
+              {"distractors", options.distractors},
+              {"background", options.background},
+              {"artefacts", {{"flying_fraction", a.flying_fraction}, {"discontinuity", a.discontinuity},
+                             {"noise_a", a.noise_a}, {"noise_b", a.noise_b},
+                             {"quantisation", a.quantisation}, {"dropout", a.dropout},
+                             {"hole_blobs", a.hole_blobs}, {"hole_blob_radius", a.hole_blob_radius},
+                             {"bleed", a.bleed}}},
+              {"provenance", provenance}};
+}
+
 }  // namespace
 
 BopSynthReport WriteBopDataset(const BopSceneGenerator& generator, const std::string& dir,
@@ -139,13 +219,7 @@ BopSynthReport WriteBopDataset(const BopSceneGenerator& generator, const std::st
   const std::size_t total = static_cast<std::size_t>(options.count);
   const int scenes = static_cast<int>((total + static_cast<std::size_t>(options.images_per_scene) - 1) /
                                       static_cast<std::size_t>(options.images_per_scene));
-  for (int s = 0; s < scenes; ++s) {
-    for (const char* sub : {"depth", "mask", "mask_visib"}) {
-      std::error_code ec;
-      fs::create_directories(folder.path() + "/" + Numbered(s) + "/" + sub, ec);
-      if (ec) throw InputError(dir, "cannot write: " + ec.message());
-    }
-  }
+  MakeSceneFolders(folder, dir, scenes);
   const int workers = std::max(1, DefaultThreadCount());
   std::vector<std::unique_ptr<DepthRenderer>> renderers;
   for (int w = 0; w < workers; ++w) renderers.push_back(generator.MakeRenderer());
@@ -162,61 +236,9 @@ BopSynthReport WriteBopDataset(const BopSceneGenerator& generator, const std::st
     ThrowIfInterrupted();
     if (progress) progress(end, total);
   }
-  BopSynthReport report;
-  report.images = total;
-  report.scenes = scenes;
-  report.distance_range = generator.distance_range();
-  report.diameter = generator.diameter();
-  report.target_visible_pixels_min = total > 0 ? records[0].target_visible_pixels : 0;
-  for (int s = 0; s < scenes; ++s) {
-    Json camera = Json::object(), gt = Json::object(), gt_info = Json::object();
-    for (const ImageRecord& record : records) {
-      if (record.scene_id != s) continue;
-      const std::string key = std::to_string(record.im_id);
-      camera[key] = record.camera;
-      gt[key] = record.gt;
-      gt_info[key] = record.gt_info;
-    }
-    const std::string scene = folder.path() + "/" + Numbered(s) + "/";
-    WriteUnsynced(scene + "scene_camera.json", DumpByKey(camera));
-    WriteUnsynced(scene + "scene_gt.json", DumpByKey(gt));
-    WriteUnsynced(scene + "scene_gt_info.json", DumpByKey(gt_info));
-  }
-  for (const ImageRecord& record : records) {
-    report.instances += record.instances;
-    report.mean_attempts += record.attempts;
-    report.mean_target_visib_fract += record.target_visib_fract;
-    report.target_visible_pixels_min = std::min(report.target_visible_pixels_min, record.target_visible_pixels);
-    report.flying += record.artefacts.flying;
-    report.dropped += record.artefacts.dropped;
-    report.bled += record.artefacts.bled;
-    report.out_of_range += record.out_of_range;
-  }
-  report.mean_attempts /= static_cast<double>(total);
-  report.mean_target_visib_fract /= static_cast<double>(total);
-  const CameraIntrinsics& c = options.camera;
-  const DepthArtefactOptions& a = options.artefacts;
-  Json info{{"generator", "c3po synth --format bop"},
-            {"version", C3PO_VERSION},
-            {"images", total},
-            {"scenes", scenes},
-            {"images_per_scene", options.images_per_scene},
-            {"seed", options.seed},
-            {"pose", ToString(options.pose.mode)},
-            {"distance_range", {generator.distance_range().first, generator.distance_range().second}},
-            {"camera", {{"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx}, {"cy", c.cy},
-                        {"width", c.width}, {"height", c.height}}},
-            {"depth_scale", options.depth_scale},
-            {"units_to_mm", options.units_to_mm},
-            {"distractors", options.distractors},
-            {"background", options.background},
-            {"artefacts", {{"flying_fraction", a.flying_fraction}, {"discontinuity", a.discontinuity},
-                           {"noise_a", a.noise_a}, {"noise_b", a.noise_b},
-                           {"quantisation", a.quantisation}, {"dropout", a.dropout},
-                           {"hole_blobs", a.hole_blobs}, {"hole_blob_radius", a.hole_blob_radius},
-                           {"bleed", a.bleed}}},
-            {"provenance", provenance}};
-  WriteUnsynced(folder.path() + "/synth_bop.json", info.dump(1) + "\n");
+  WriteSceneFiles(folder, scenes, records);
+  BopSynthReport report = ReportOf(generator, scenes, records);
+  WriteUnsynced(folder.path() + "/synth_bop.json", DatasetInfo(generator, total, scenes, provenance).dump(1) + "\n");
   folder.Commit();
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
