@@ -150,92 +150,110 @@ void CertifyBatchOptions::Check() const {
   if (auto_eps_oc) auto_eps_oc_options.Check();
 }
 
+namespace {
+
+void RequireDetectorOrKeypoints(const std::vector<CloudSource>& sources, const Detector* detector) {
+  if (detector) return;
+  for (const CloudSource& source : sources) {
+    if (!source.given_keypoints) {
+      throw InputError(WhereOf(source),
+                       "no detector, and no given keypoints (a manifest line's \"detected_keypoints\")");
+    }
+  }
+}
+
+// Runs `step`; any error but an interruption becomes the outcome's failure (kind and message).
+template <typename Step>
+void RecordFailure(CloudOutcome* outcome, CloudOutcome::Failure kind, const Step& step) {
+  try {
+    step();
+  } catch (const Interrupted&) {
+    throw;
+  } catch (const std::exception& e) {
+    outcome->failure = kind;
+    outcome->error = e.what();
+  }
+}
+
+void DetectKeypoints(const CloudSource& source, const PointSet& cloud, const Detector* detector, int num_keypoints,
+                     CloudOutcome* outcome) {
+  outcome->detected_keypoints = detector ? detector->Detect(cloud) : *source.given_keypoints;
+  if (outcome->detected_keypoints.cols() != num_keypoints) {
+    throw InputError(WhereOf(source), "detected " + std::to_string(outcome->detected_keypoints.cols()) +
+                                          " keypoints, object has " + std::to_string(num_keypoints));
+  }
+}
+
+// Counts of the processed outcomes: errors, certified, oc and nd passed.
+void CountOutcomes(CertifyBatchResult* result) {
+  for (const CloudOutcome& outcome : result->outcomes) {
+    if (!outcome.processed()) {
+      ++result->errors;
+      continue;
+    }
+    result->certified += outcome.estimate.certified();
+    result->oc += outcome.estimate.certificate.oc.passed;
+    result->nd += outcome.estimate.certificate.nd.passed;
+  }
+}
+
+}  // namespace
+
 CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<CloudSource>& sources,
                                 const Detector* detector, const CertifyBatchOptions& options,
                                 const ProgressCallback& progress, const CloudVisitor& visit) {
   options.Check();
-  if (!detector) {
-    for (const CloudSource& source : sources) {
-      if (!source.given_keypoints) {
-        throw InputError(WhereOf(source), "no detector, and no given keypoints (a manifest line's \"detected_keypoints\")");
-      }
-    }
-  }
+  RequireDetectorOrKeypoints(sources, detector);
   CertifyBatchResult result;
   result.outcomes.resize(sources.size());
   result.certificate = options.pipeline.certificate;
   std::vector<PointSet> clouds(options.auto_eps_oc ? sources.size() : 0);   // kept for auto eps_oc
   PipelineOptions uncorrected = options.pipeline;
   uncorrected.correct = false;
-  const int num_keypoints = object.num_keypoints();
   std::atomic<std::size_t> done{0};
-  ParallelFor(0, static_cast<int>(sources.size()), [&](int i) {
-    ThrowIfInterrupted();
+  // One source: load, detect, estimate and certify (the free-space test from its frame), judge
+  // against its truth, hand to the visitor; failures are recorded in its outcome.
+  const auto certify_source = [&](std::size_t i, std::chrono::steady_clock::time_point start) {
     const CloudSource& source = sources[i];
     CloudOutcome& outcome = result.outcomes[i];
-    const auto start = std::chrono::steady_clock::now();
     PointSet cloud;
     DepthView view;   // image inputs: the frame, for the free-space test
-    try {
-      cloud = LoadSourceCloud(source, &outcome.segment, &view);
-    } catch (const Interrupted&) {
-      throw;
-    } catch (const std::exception& e) {
-      outcome.failure = CloudOutcome::Failure::kLoad;
-      outcome.error = e.what();
+    RecordFailure(&outcome, CloudOutcome::Failure::kLoad,
+                  [&] { cloud = LoadSourceCloud(source, &outcome.segment, &view); });
+    if (!outcome.processed()) return;
+    RecordFailure(&outcome, CloudOutcome::Failure::kDetect,
+                  [&] { DetectKeypoints(source, cloud, detector, object.num_keypoints(), &outcome); });
+    if (!outcome.processed()) return;
+    const std::optional<FreeSpaceTest> free_space = MakeFreeSpaceTest(
+        object, view, options.pipeline.certificate.free_space, options.pipeline.certificate.eps_oc);
+    const FreeSpaceTest* free_space_test = free_space ? &*free_space : nullptr;
+    if (options.also_uncorrected) {
+      outcome.uncorrected = EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected, free_space_test);
     }
-    if (outcome.processed()) {
-      try {
-        outcome.detected_keypoints = detector ? detector->Detect(cloud) : *source.given_keypoints;
-        if (outcome.detected_keypoints.cols() != num_keypoints) {
-          throw InputError(WhereOf(source), "detected " + std::to_string(outcome.detected_keypoints.cols()) +
-                                                " keypoints, object has " + std::to_string(num_keypoints));
-        }
-      } catch (const Interrupted&) {
-        throw;
-      } catch (const std::exception& e) {
-        outcome.failure = CloudOutcome::Failure::kDetect;
-        outcome.error = e.what();
-      }
+    outcome.estimate = EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline, free_space_test);
+    if (source.scene_from_model_truth && outcome.estimate.ok()) {
+      outcome.truth_hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000),
+                                                    *source.scene_from_model_truth, outcome.estimate.scene_from_model);
     }
-    if (outcome.processed()) {
-      const std::optional<FreeSpaceTest> free_space = MakeFreeSpaceTest(
-          object, view, options.pipeline.certificate.free_space, options.pipeline.certificate.eps_oc);
-      const FreeSpaceTest* free_space_test = free_space ? &*free_space : nullptr;
-      if (options.also_uncorrected) {
-        outcome.uncorrected =
-            EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected, free_space_test);
-      }
-      outcome.estimate =
-          EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline, free_space_test);
-      if (source.scene_from_model_truth && outcome.estimate.ok()) {
-        outcome.truth_hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000),
-                                                      *source.scene_from_model_truth,
-                                                      outcome.estimate.scene_from_model);
-      }
-      outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (visit) visit(static_cast<std::size_t>(i), cloud, free_space_test, &outcome);
-      if (options.auto_eps_oc) clouds[i] = std::move(cloud);
-    }
-    if (outcome.seconds == 0.0) {
+    outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (visit) visit(i, cloud, free_space_test, &outcome);
+    if (options.auto_eps_oc) clouds[i] = std::move(cloud);
+  };
+  ParallelFor(0, static_cast<int>(sources.size()), [&](int i) {
+    ThrowIfInterrupted();
+    const auto start = std::chrono::steady_clock::now();
+    certify_source(static_cast<std::size_t>(i), start);
+    CloudOutcome& outcome = result.outcomes[static_cast<std::size_t>(i)];
+    if (outcome.seconds == 0.0) {   // failed before the estimate
       outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
     if (progress) progress(++done, sources.size());
   });
-
   if (options.auto_eps_oc) {
     result.auto_eps_oc = DecideAutoEpsOc(object, clouds, options, &result);
     result.certificate.eps_oc = result.auto_eps_oc->eps_oc;
   }
-  for (const CloudOutcome& outcome : result.outcomes) {
-    if (!outcome.processed()) {
-      ++result.errors;
-      continue;
-    }
-    result.certified += outcome.estimate.certified();
-    result.oc += outcome.estimate.certificate.oc.passed;
-    result.nd += outcome.estimate.certificate.nd.passed;
-  }
+  CountOutcomes(&result);
   return result;
 }
 
