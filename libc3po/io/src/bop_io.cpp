@@ -59,49 +59,46 @@ bool Exists(const std::string& path) {
   return fs::exists(path, ec);
 }
 
-// Instances of one scene folder.
-void ListScene(const std::string& scene_dir, int scene_id, const BopOptions& options,
-               const std::set<std::pair<int, int>>* target_images, BopInstances* out) {
-  const std::string camera_path = scene_dir + "/scene_camera.json";
-  const std::map<int, CameraInfo> cameras = ParseSceneCamera(ReadFileToString(camera_path), camera_path);
-  auto camera_of = [&](int im_id) -> const CameraInfo& {
+// One scene folder being listed: its cameras and which of its images are wanted.
+struct SceneListing {
+  std::string dir;
+  int scene_id = 0;
+  std::string camera_path;
+  std::map<int, CameraInfo> cameras;
+  const std::set<std::pair<int, int>>* target_images = nullptr;
+
+  const CameraInfo& CameraOf(int im_id) const {
     const auto it = cameras.find(im_id);
     if (it == cameras.end()) throw InputError(camera_path, "no entry for image " + std::to_string(im_id));
     return it->second;
-  };
-  auto wanted = [&](int im_id) {
-    return !target_images || target_images->count({scene_id, im_id}) > 0;
-  };
-  if (!options.detections_path.empty()) {
-    for (std::size_t i = 0; i < out->detections.size(); ++i) {
-      const BopDetection& detection = out->detections[i];
-      if (detection.scene_id != scene_id || detection.category_id != options.obj_id ||
-          detection.score < options.min_score || !wanted(detection.image_id)) {
-        continue;
-      }
-      BopInstance instance;
-      instance.scene_id = scene_id;
-      instance.im_id = detection.image_id;
-      instance.gt_id = static_cast<int>(i);
-      instance.obj_id = detection.category_id;
-      instance.depth_path = scene_dir + "/depth/" + Id6(detection.image_id) + ".png";
-      instance.detection = &detection;
-      instance.score = detection.score;
-      instance.camera = camera_of(detection.image_id);
-      out->instances.push_back(instance);
+  }
+  bool Wanted(int im_id) const { return !target_images || target_images->count({scene_id, im_id}) > 0; }
+};
+
+// Instances from --detections: the scene's detections of the object scoring at least min_score.
+void ListDetectedInstances(const SceneListing& scene, const BopOptions& options, BopInstances* out) {
+  for (std::size_t i = 0; i < out->detections.size(); ++i) {
+    const BopDetection& detection = out->detections[i];
+    if (detection.scene_id != scene.scene_id || detection.category_id != options.obj_id ||
+        detection.score < options.min_score || !scene.Wanted(detection.image_id)) {
+      continue;
     }
-    return;
+    BopInstance instance;
+    instance.scene_id = scene.scene_id;
+    instance.im_id = detection.image_id;
+    instance.gt_id = static_cast<int>(i);
+    instance.obj_id = detection.category_id;
+    instance.depth_path = scene.dir + "/depth/" + Id6(detection.image_id) + ".png";
+    instance.detection = &detection;
+    instance.score = detection.score;
+    instance.camera = scene.CameraOf(detection.image_id);
+    out->instances.push_back(instance);
   }
-  const std::string gt_path = scene_dir + "/scene_gt.json";
-  if (!Exists(gt_path)) {
-    throw InputError(scene_dir, "no scene_gt.json: ground-truth masks need it (or give --detections FILE)");
-  }
-  const auto gt = ParseSceneGt(ReadFileToString(gt_path), gt_path);
-  std::string mask_dir = scene_dir + "/mask_visib";
-  if (!Exists(mask_dir)) mask_dir = scene_dir + "/mask";
-  if (!Exists(mask_dir)) throw InputError(scene_dir, "no mask_visib/ or mask/ folder");
-  // The mask files must be exactly the scene_gt.json instances.
-  std::map<int, std::set<int>> masks;   // im_id -> gt_ids with a mask file
+}
+
+// im_id -> gt_ids of the instance masks (IMAGE_GTID.png, six digits each) in mask_dir.
+std::map<int, std::set<int>> InstanceMasks(const std::string& mask_dir) {
+  std::map<int, std::set<int>> masks;
   std::error_code ec;
   for (fs::directory_iterator it(mask_dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string leaf = it->path().filename().string();
@@ -112,39 +109,76 @@ void ListScene(const std::string& scene_dir, int scene_id, const BopOptions& opt
     masks[std::stoi(leaf.substr(0, 6))].insert(std::stoi(leaf.substr(7, 6)));
   }
   if (ec) throw InputError(mask_dir, "cannot list: " + ec.message());
+  return masks;
+}
+
+// The mask files must be exactly the scene_gt.json instances.
+void RequireMasksOfGroundTruth(const std::map<int, std::vector<BopGroundTruth>>& gt,
+                               const std::map<int, std::set<int>>& masks, const std::string& gt_path,
+                               const std::string& mask_dir) {
+  const std::string mask_folder = fs::path(mask_dir).filename().string();
   for (const auto& [im_id, list] : gt) {
     const auto it = masks.find(im_id);
     const std::size_t files = it == masks.end() ? 0 : it->second.size();
-    const bool complete = list.empty() ? files == 0
-                                       : files == list.size() && *it->second.rbegin() == static_cast<int>(list.size()) - 1;
+    const int last_gt_id = static_cast<int>(list.size()) - 1;
+    const bool complete = list.empty() ? files == 0 : files == list.size() && *it->second.rbegin() == last_gt_id;
     if (!complete) {
       throw InputError(gt_path, "image " + std::to_string(im_id) + " lists " + std::to_string(list.size()) +
-                                    " instances but " + fs::path(mask_dir).filename().string() + "/ holds " +
+                                    " instances but " + mask_folder + "/ holds " +
                                     std::to_string(files) + " masks " + Id6(im_id) + "_*.png (expected gt_id 0.." +
                                     std::to_string(static_cast<int>(list.size()) - 1) + ")");
     }
   }
   for (const auto& [im_id, ids] : masks) {
     if (!gt.count(im_id)) {
-      throw InputError(gt_path, "no entry for image " + std::to_string(im_id) + " but " +
-                                    fs::path(mask_dir).filename().string() + "/ holds its masks");
+      throw InputError(gt_path, "no entry for image " + std::to_string(im_id) + " but " + mask_folder +
+                                    "/ holds its masks");
     }
   }
+}
+
+// Instances from the ground truth: the object's entries in scene_gt.json with their masks.
+void ListGroundTruthInstances(const SceneListing& scene, const BopOptions& options, BopInstances* out) {
+  const std::string gt_path = scene.dir + "/scene_gt.json";
+  if (!Exists(gt_path)) {
+    throw InputError(scene.dir, "no scene_gt.json: ground-truth masks need it (or give --detections FILE)");
+  }
+  const auto gt = ParseSceneGt(ReadFileToString(gt_path), gt_path);
+  std::string mask_dir = scene.dir + "/mask_visib";
+  if (!Exists(mask_dir)) mask_dir = scene.dir + "/mask";
+  if (!Exists(mask_dir)) throw InputError(scene.dir, "no mask_visib/ or mask/ folder");
+  RequireMasksOfGroundTruth(gt, InstanceMasks(mask_dir), gt_path, mask_dir);
   for (const auto& [im_id, list] : gt) {
-    if (!wanted(im_id)) continue;
+    if (!scene.Wanted(im_id)) continue;
     for (std::size_t gt_id = 0; gt_id < list.size(); ++gt_id) {
       if (list[gt_id].obj_id != options.obj_id) continue;
       BopInstance instance;
-      instance.scene_id = scene_id;
+      instance.scene_id = scene.scene_id;
       instance.im_id = im_id;
       instance.gt_id = static_cast<int>(gt_id);
       instance.obj_id = options.obj_id;
-      instance.depth_path = scene_dir + "/depth/" + Id6(im_id) + ".png";
+      instance.depth_path = scene.dir + "/depth/" + Id6(im_id) + ".png";
       instance.mask_path = mask_dir + "/" + Id6(im_id) + "_" + Id6(static_cast<int>(gt_id)) + ".png";
-      instance.camera = camera_of(im_id);
+      instance.camera = scene.CameraOf(im_id);
       instance.ground_truth = list[gt_id].camera_from_model;
       out->instances.push_back(instance);
     }
+  }
+}
+
+// Instances of one scene folder.
+void ListScene(const std::string& scene_dir, int scene_id, const BopOptions& options,
+               const std::set<std::pair<int, int>>* target_images, BopInstances* out) {
+  SceneListing scene;
+  scene.dir = scene_dir;
+  scene.scene_id = scene_id;
+  scene.camera_path = scene_dir + "/scene_camera.json";
+  scene.cameras = ParseSceneCamera(ReadFileToString(scene.camera_path), scene.camera_path);
+  scene.target_images = target_images;
+  if (!options.detections_path.empty()) {
+    ListDetectedInstances(scene, options, out);
+  } else {
+    ListGroundTruthInstances(scene, options, out);
   }
 }
 
