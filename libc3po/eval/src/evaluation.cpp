@@ -390,6 +390,72 @@ void CheckEvaluationDataset(const ObjectModel& object, const Dataset& dataset,
   }
 }
 
+namespace {
+
+// How the object's own clouds fared with one detector (the corrected samples).
+ObjectAcceptance OwnAcceptance(const std::string& detector, const ObjectModel& object,
+                               const std::vector<SampleResult>& corrected) {
+  ObjectAcceptance own;
+  own.detector = detector;
+  own.object = object.name();
+  own.evaluated_object = true;
+  for (const SampleResult& sample : corrected) {
+    ++own.clouds;
+    own.failures += !sample.ok();
+    own.observably_correct += sample.fits_observation();
+    own.certified += sample.certified();
+  }
+  return own;
+}
+
+// What the object's certifier accepted of another object's clouds (`members` of `other`).
+ObjectAcceptance OtherAcceptance(const std::string& detector, const std::string& label,
+                                 const std::vector<std::size_t>& members, const CertifyBatchResult& other) {
+  ObjectAcceptance a;
+  a.detector = detector;
+  a.object = label;
+  for (std::size_t i : members) {
+    const CloudOutcome& outcome = other.outcomes[i];
+    ++a.clouds;
+    a.failures += !outcome.processed();
+    a.observably_correct +=
+        outcome.processed() && outcome.estimate.ok() && outcome.estimate.certificate.fits_observation();
+    a.certified += outcome.certified();
+  }
+  return a;
+}
+
+// Mixed datasets, per detector: the object's own clouds, then each other label's clouds certified
+// as this object (every one accepted is a false certificate of the segmenter's kind).
+std::vector<ObjectAcceptance> AcceptanceByObject(const ObjectModel& object, const Dataset& other_dataset,
+                                                 const DatasetFrames& frames,
+                                                 const std::vector<EvaluatedDetector>& detectors,
+                                                 const std::vector<DetectorResults>& results,
+                                                 const EvaluationOptions& options) {
+  std::map<std::string, std::vector<std::size_t>> other_by_label;
+  for (std::size_t i = 0; i < other_dataset.entries.size(); ++i) {
+    other_by_label[*other_dataset.entries[i].object].push_back(i);
+  }
+  const std::vector<CloudSource> other_sources = DatasetSources(other_dataset, frames);
+  CertifyBatchOptions batch;
+  batch.pipeline = options.pipeline;
+  batch.pipeline.correct = true;
+  std::vector<ObjectAcceptance> objects;
+  for (std::size_t d = 0; d < detectors.size(); ++d) {
+    objects.push_back(OwnAcceptance(detectors[d].label, object, results[d][kCorrected]));
+    if (other_sources.empty()) continue;
+    // A detector's failure on a cloud (e.g. the manifest's detected
+    // keypoints are another object's count) rejects that cloud.
+    const CertifyBatchResult other = CertifyBatch(object, other_sources, detectors[d].detector, batch);
+    for (const auto& [label, members] : other_by_label) {
+      objects.push_back(OtherAcceptance(detectors[d].label, label, members, other));
+    }
+  }
+  return objects;
+}
+
+}  // namespace
+
 Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
                     const std::vector<EvaluatedDetector>& detectors,
                     const EvaluationOptions& options, const ProgressCallback& progress,
@@ -415,47 +481,9 @@ Evaluation Evaluate(const ObjectModel& object, const Dataset& dataset,
     };
     results.push_back(EvaluateDetector(object, own_dataset, sources, detectors[d], options, per_detector));
   }
-  const bool mixed = !other_dataset.entries.empty();
   std::vector<ObjectAcceptance> objects;
-  if (mixed) {
-    std::map<std::string, std::vector<std::size_t>> other_by_label;
-    for (std::size_t i = 0; i < other_dataset.entries.size(); ++i) {
-      other_by_label[*other_dataset.entries[i].object].push_back(i);
-    }
-    const std::vector<CloudSource> other_sources = DatasetSources(other_dataset, frames);
-    CertifyBatchOptions batch;
-    batch.pipeline = options.pipeline;
-    batch.pipeline.correct = true;
-    for (std::size_t d = 0; d < detectors.size(); ++d) {
-      ObjectAcceptance own;
-      own.detector = detectors[d].label;
-      own.object = object.name();
-      own.evaluated_object = true;
-      for (const SampleResult& sample : results[d][kCorrected]) {
-        ++own.clouds;
-        own.failures += !sample.ok();
-        own.observably_correct += sample.fits_observation();
-        own.certified += sample.certified();
-      }
-      objects.push_back(own);
-      if (other_sources.empty()) continue;
-      // A detector's failure on a cloud (e.g. the manifest's detected
-      // keypoints are another object's count) rejects that cloud.
-      const CertifyBatchResult other = CertifyBatch(object, other_sources, detectors[d].detector, batch);
-      for (const auto& [label, members] : other_by_label) {
-        ObjectAcceptance a;
-        a.detector = detectors[d].label;
-        a.object = label;
-        for (std::size_t i : members) {
-          const CloudOutcome& outcome = other.outcomes[i];
-          ++a.clouds;
-          a.failures += !outcome.processed();
-          a.observably_correct += outcome.processed() && outcome.estimate.ok() && outcome.estimate.certificate.fits_observation();
-          a.certified += outcome.certified();
-        }
-        objects.push_back(a);
-      }
-    }
+  if (!other_dataset.entries.empty()) {
+    objects = AcceptanceByObject(object, other_dataset, frames, detectors, results, options);
   }
 
   Evaluation evaluation;
