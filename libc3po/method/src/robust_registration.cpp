@@ -265,26 +265,24 @@ void RobustRegistrationOptions::Check() const {
   gnc_checked.Check();
 }
 
-RobustRegistrationResult RegisterRobust(const PointSet& model, const PointSet& scene,
-                                        const RobustRegistrationOptions& options) {
-  options.Check();
-  if (model.cols() != scene.cols()) throw std::invalid_argument("RegisterRobust: sizes differ");
-  RobustRegistrationResult result;
-  // Finite correspondences, the first max_correspondences of them.
+namespace {
+
+// Indices of the finite correspondences, the first `cap` of them.
+std::vector<int> FiniteCorrespondences(const PointSet& model, const PointSet& scene, int cap) {
   std::vector<int> kept;
   for (Eigen::Index i = 0; i < model.cols(); ++i) {
     if (model.col(i).allFinite() && scene.col(i).allFinite()) kept.push_back(static_cast<int>(i));
-    if (static_cast<int>(kept.size()) == options.max_correspondences) break;
+    if (static_cast<int>(kept.size()) == cap) break;
   }
+  return kept;
+}
+
+// TIM consistency graph at scale 1: kept correspondences i, j are adjacent when their distances
+// in model and scene differ by at most `tolerance`.
+Graph ConsistencyGraph(const PointSet& model, const PointSet& scene, const std::vector<int>& kept,
+                       double tolerance) {
   const int m = static_cast<int>(kept.size());
-  result.correspondences = m;
-  if (m < 3) {
-    result.failure = "fewer than 3 correspondences";
-    return result;
-  }
-  // Step 2: TIM consistency graph (scale 1) and its maximum clique.
   Graph graph(m);
-  const double tolerance = 2 * options.noise_bound;
   for (int i = 0; i < m; ++i) {
     for (int j = i + 1; j < m; ++j) {
       const double dm = (model.col(kept[j]) - model.col(kept[i])).norm();
@@ -295,7 +293,64 @@ RobustRegistrationResult RegisterRobust(const PointSet& model, const PointSet& s
       }
     }
   }
-  const MaxCliqueResult clique = MaximumClique(graph, options.max_clique_branches);
+  return graph;
+}
+
+// The translation-invariant measurements (TIMs) b_j - b_i and a_j - a_i of the members' pairs,
+// every pair or, above `cap`, pairs strided evenly over them.
+std::pair<PointSet, PointSet> StridedTims(const PointSet& model, const PointSet& scene, const std::vector<int>& members,
+                                          int cap) {
+  const std::int64_t c = static_cast<std::int64_t>(members.size());
+  const std::int64_t pairs = c * (c - 1) / 2;
+  const std::int64_t used = std::min<std::int64_t>(pairs, cap);
+  PointSet tim_model(3, used), tim_scene(3, used);
+  std::int64_t pair = 0, next_column = 0;
+  for (std::int64_t i = 0; i < c && next_column < used; ++i) {
+    for (std::int64_t j = i + 1; j < c && next_column < used; ++j, ++pair) {
+      if (pair != next_column * pairs / used) continue;
+      tim_model.col(next_column) = model.col(members[j]) - model.col(members[i]);
+      tim_scene.col(next_column) = scene.col(members[j]) - scene.col(members[i]);
+      ++next_column;
+    }
+  }
+  if (next_column != used) {
+    tim_model.conservativeResize(3, next_column);
+    tim_scene.conservativeResize(3, next_column);
+  }
+  return {tim_model, tim_scene};
+}
+
+// Component-wise adaptive voting for t = a_i - R b_i over the members.
+Eigen::Vector3d VotedTranslation(const PointSet& model, const PointSet& scene, const std::vector<int>& members,
+                                 const Eigen::Matrix3d& R, double noise_bound) {
+  Eigen::Vector3d t;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> values, bounds;
+    for (int i : members) {
+      values.push_back(scene(k, i) - (R * model.col(i))(k));
+      bounds.push_back(noise_bound);
+    }
+    t(k) = AdaptiveVoting(values, bounds).value;
+  }
+  return t;
+}
+
+}  // namespace
+
+RobustRegistrationResult RegisterRobust(const PointSet& model, const PointSet& scene,
+                                        const RobustRegistrationOptions& options) {
+  options.Check();
+  if (model.cols() != scene.cols()) throw std::invalid_argument("RegisterRobust: sizes differ");
+  RobustRegistrationResult result;
+  const std::vector<int> kept = FiniteCorrespondences(model, scene, options.max_correspondences);
+  result.correspondences = static_cast<int>(kept.size());
+  if (result.correspondences < 3) {
+    result.failure = "fewer than 3 correspondences";
+    return result;
+  }
+  // Step 2: TIM consistency graph (scale 1) and its maximum clique.
+  const MaxCliqueResult clique =
+      MaximumClique(ConsistencyGraph(model, scene, kept, 2 * options.noise_bound), options.max_clique_branches);
   result.clique_size = static_cast<int>(clique.clique.size());
   result.clique_exact = clique.exact;
   if (result.clique_size < 3) {
@@ -305,25 +360,7 @@ RobustRegistrationResult RegisterRobust(const PointSet& model, const PointSet& s
   std::vector<int> members;
   for (int v : clique.clique) members.push_back(kept[v]);
   // Step 3: GNC-TLS rotation on the TIMs of the clique (every pair, strided to the cap).
-  const std::int64_t c = static_cast<std::int64_t>(members.size());
-  const std::int64_t pairs = c * (c - 1) / 2;
-  const std::int64_t used = std::min<std::int64_t>(pairs, options.max_rotation_tims);
-  PointSet tim_model(3, used), tim_scene(3, used);
-  {
-    std::int64_t pair = 0, next_column = 0;
-    for (std::int64_t i = 0; i < c && next_column < used; ++i) {
-      for (std::int64_t j = i + 1; j < c && next_column < used; ++j, ++pair) {
-        if (pair != next_column * pairs / used) continue;
-        tim_model.col(next_column) = model.col(members[j]) - model.col(members[i]);
-        tim_scene.col(next_column) = scene.col(members[j]) - scene.col(members[i]);
-        ++next_column;
-      }
-    }
-    if (next_column != used) {
-      tim_model.conservativeResize(3, next_column);
-      tim_scene.conservativeResize(3, next_column);
-    }
-  }
+  const auto [tim_model, tim_scene] = StridedTims(model, scene, members, options.max_rotation_tims);
   GncTlsOptions gnc = options.gnc;
   gnc.noise_bound = 2 * options.noise_bound;
   const GncTlsRotationResult rotation = GncTlsRotation(tim_model, tim_scene, gnc);
@@ -332,18 +369,9 @@ RobustRegistrationResult RegisterRobust(const PointSet& model, const PointSet& s
     result.failure = "GNC-TLS rotation found fewer than 2 consistent invariants";
     return result;
   }
-  // Step 4: component-wise adaptive voting for t = a_i - R b_i.
-  Eigen::Vector3d t;
-  for (int k = 0; k < 3; ++k) {
-    std::vector<double> values, bounds;
-    for (int i : members) {
-      values.push_back(scene(k, i) - (rotation.R * model.col(i))(k));
-      bounds.push_back(options.noise_bound);
-    }
-    t(k) = AdaptiveVoting(values, bounds).value;
-  }
+  // Step 4: component-wise adaptive voting for the translation.
   result.scene_from_model.R = rotation.R;
-  result.scene_from_model.t = t;
+  result.scene_from_model.t = VotedTranslation(model, scene, members, rotation.R, options.noise_bound);
   for (int i : members) {
     const Eigen::Vector3d r = scene.col(i) - result.scene_from_model * Eigen::Vector3d(model.col(i));
     if (r.cwiseAbs().maxCoeff() <= options.noise_bound) ++result.translation_inliers;
