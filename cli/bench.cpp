@@ -80,9 +80,7 @@ std::vector<double> ParseNumberList(const std::string& text, const std::string& 
   return values;
 }
 
-int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
-  const ObjectModel object = LoadObject(cmd.object_path);
-  const Dataset dataset = ReadDataset(cmd.data_dir);
+CorrectorBenchmarkOptions CorrectorBenchOptions(const CorrectorBenchCommand& cmd, const ObjectModel& object) {
   CorrectorBenchmarkOptions options;
   options.sigmas = ParseNumberList(cmd.sigmas, "--sigma");
   options.fraction = cmd.fraction;
@@ -106,12 +104,11 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
   } catch (const std::invalid_argument& e) {
     throw InputError("corrector", e.what());
   }
-  ProgressBar progress("corrector", 1);
-  std::vector<CorrectorBenchmarkCase> cases;
-  const auto rows = RunCorrectorBenchmark(object, dataset, options, [&](std::size_t done, std::size_t total) {
-    progress.Update(done * 1000 / std::max<std::size_t>(total, 1) / 1000);
-  }, cmd.cases_path.empty() ? nullptr : &cases);
-  progress.Finish();
+  return options;
+}
+
+void PrintCorrectorBenchHeader(const ObjectModel& object, const CorrectorBenchmarkOptions& options,
+                               const std::vector<CorrectorBenchmarkRow>& rows) {
   std::printf("corrector analysis: %s, %d clouds, %.0f%% of keypoints perturbed by U[-sigma d/2, sigma d/2], "
               "d = %.4g, eps_oc = %.4g, loss = %s, %s, %d thread(s)\n",
               object.name().c_str(), rows.empty() ? 0 : rows[0].clouds, 100 * options.fraction,
@@ -126,6 +123,10 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
   std::printf("%6s  %-18s %9s %9s %9s %9s %9s %7s %8s %8s %8s %8s %7s %7s %7s %7s %6s %8s\n", "sigma", "method", "rot med", "rot mean",
               "t/d med", "t/d mean", "ADD-S/d", "% oc", "corr", "corr cpu", "cert", "total", "iters",
               "%corr", "%cert", "%c.cert", "false", "nd q05");
+}
+
+// Prints each row under the header and returns them as the --json document.
+nlohmann::json PrintCorrectorBenchRows(const std::vector<CorrectorBenchmarkRow>& rows) {
   nlohmann::json json = nlohmann::json::array();
   for (const auto& row : rows) {
     std::printf("%6.2f  %-18s %8.2f° %8.2f° %9.4f %9.4f %9.4f %7.1f %8.3f %8.3f %8.3f %8.3f %7.1f %7.1f %7.1f %7.1f %6d %8.4f\n", row.sigma,
@@ -152,6 +153,21 @@ int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
                     {"q05_nd_eigenvalue_correct", row.q05_nd_eigenvalue_correct},
                     {"percent_nd_local", row.percent_nd_local}});
   }
+  return json;
+}
+
+int RunCorrectorBench(const CorrectorBenchCommand& cmd) {
+  const ObjectModel object = LoadObject(cmd.object_path);
+  const Dataset dataset = ReadDataset(cmd.data_dir);
+  const CorrectorBenchmarkOptions options = CorrectorBenchOptions(cmd, object);
+  ProgressBar progress("corrector", 1);
+  std::vector<CorrectorBenchmarkCase> cases;
+  const auto rows = RunCorrectorBenchmark(object, dataset, options, [&](std::size_t done, std::size_t total) {
+    progress.Update(done * 1000 / std::max<std::size_t>(total, 1) / 1000);
+  }, cmd.cases_path.empty() ? nullptr : &cases);
+  progress.Finish();
+  PrintCorrectorBenchHeader(object, options, rows);
+  const nlohmann::json json = PrintCorrectorBenchRows(rows);
   if (!cmd.json_path.empty()) WriteFileAtomically(cmd.json_path, json.dump(2) + "\n");
   if (!cmd.cases_path.empty()) WriteFileAtomically(cmd.cases_path, CasesJsonLines(object, dataset, options, cases));
   return 0;
