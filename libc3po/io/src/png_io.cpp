@@ -45,7 +45,10 @@ Image::Image(int width_, int height_, int bit_depth_)
   pixels.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0);
 }
 
-Image DecodePng(const std::string& bytes, const std::string& name) {
+namespace {
+
+// The raw scanlines of a single-channel PNG (and its header), after the size and truncation checks.
+std::vector<unsigned char> DecodeGreyscaleRows(const std::string& bytes, const std::string& name, spng_ihdr* ihdr) {
   CtxPtr ctx(spng_ctx_new(0));
   if (!ctx) throw std::bad_alloc();
   spng_set_image_limits(ctx.get(), 1u << 20, 1u << 20);
@@ -53,15 +56,14 @@ Image DecodePng(const std::string& bytes, const std::string& name) {
   if (int err = spng_set_png_buffer(ctx.get(), bytes.data(), bytes.size())) {
     throw InputError(name, std::string("not a PNG: ") + spng_strerror(err));
   }
-  spng_ihdr ihdr{};
-  if (int err = spng_get_ihdr(ctx.get(), &ihdr)) {
+  if (int err = spng_get_ihdr(ctx.get(), ihdr)) {
     throw InputError(name, std::string("not a readable PNG: ") + spng_strerror(err));
   }
-  if (ihdr.color_type != SPNG_COLOR_TYPE_GRAYSCALE) {
-    throw InputError(name, std::string(ColourTypeName(ihdr.color_type)) +
+  if (ihdr->color_type != SPNG_COLOR_TYPE_GRAYSCALE) {
+    throw InputError(name, std::string(ColourTypeName(ihdr->color_type)) +
                                " PNG; expected a single-channel (greyscale) image");
   }
-  const std::size_t width = ihdr.width, height = ihdr.height;
+  const std::size_t width = ihdr->width, height = ihdr->height;
   if (width == 0 || height == 0) throw InputError(name, "PNG of zero size");
   if (width * height > kMaxImagePixels) {
     throw InputError(name, "PNG of " + std::to_string(width) + " x " + std::to_string(height) +
@@ -87,13 +89,18 @@ Image DecodePng(const std::string& bytes, const std::string& name) {
     throw InputError(name, std::string("truncated or damaged PNG after the image data: ") +
                                spng_strerror(err));
   }
-  const int depth = ihdr.bit_depth;
-  Image image(static_cast<int>(width), static_cast<int>(height), depth == 16 ? 16 : 8);
+  return raw;
+}
+
+// Scanlines of 1, 2, 4, 8 or 16 bits per pixel (PNG order: big-endian, packed from the most
+// significant bit) into pixels.
+void UnpackRows(const std::vector<unsigned char>& raw, std::size_t width, std::size_t height, int depth,
+                const std::string& name, Image* image) {
   const std::size_t stride = (width * static_cast<std::size_t>(depth) + 7) / 8;
   if (raw.size() < stride * height) throw InputError(name, "damaged PNG: short image data");
   for (std::size_t v = 0; v < height; ++v) {
     const unsigned char* row = raw.data() + v * stride;
-    std::uint16_t* out = image.pixels.data() + v * width;
+    std::uint16_t* out = image->pixels.data() + v * width;
     if (depth == 16) {
       for (std::size_t u = 0; u < width; ++u) {
         out[u] = static_cast<std::uint16_t>((row[2 * u] << 8) | row[2 * u + 1]);  // big-endian
@@ -109,6 +116,16 @@ Image DecodePng(const std::string& bytes, const std::string& name) {
       }
     }
   }
+}
+
+}  // namespace
+
+Image DecodePng(const std::string& bytes, const std::string& name) {
+  spng_ihdr ihdr{};
+  const std::vector<unsigned char> raw = DecodeGreyscaleRows(bytes, name, &ihdr);
+  const int depth = ihdr.bit_depth;
+  Image image(static_cast<int>(ihdr.width), static_cast<int>(ihdr.height), depth == 16 ? 16 : 8);
+  UnpackRows(raw, ihdr.width, ihdr.height, depth, name, &image);
   return image;
 }
 
