@@ -145,6 +145,66 @@ ArtefactCounts ApplyDepthArtefacts(const DepthArtefactOptions& options, int widt
   return counts;
 }
 
+namespace {
+
+// Pixel rectangle [u0, u1] x [v0, v1]; empty when u1 < u0.
+struct PixelBox {
+  int u0, v0, u1, v1;
+  int width() const { return u1 - u0 + 1; }
+};
+
+// The bounding box of the mask's non-zero pixels grown by `pixels`, within the image.
+PixelBox GrownMaskBox(const std::vector<std::uint8_t>& mask, int width, int height, int pixels) {
+  PixelBox box{width, height, -1, -1};
+  for (int v = 0; v < height; ++v) {
+    const std::uint8_t* row = mask.data() + static_cast<std::size_t>(v) * width;
+    for (int u = 0; u < width; ++u) {
+      if (!row[u]) continue;
+      box.u0 = std::min(box.u0, u), box.u1 = std::max(box.u1, u);
+      box.v0 = std::min(box.v0, v), box.v1 = std::max(box.v1, v);
+    }
+  }
+  if (box.u1 < 0) return box;
+  return {std::max(0, box.u0 - pixels), std::max(0, box.v0 - pixels), std::min(width - 1, box.u1 + pixels),
+          std::min(height - 1, box.v1 + pixels)};
+}
+
+constexpr int kFar = 1 << 29;
+
+// nearest[(v - v0) * box width + (u - u0)] = |u - the nearest mask column in row v| (kFar: none):
+// a pass from the left and one from the right per row.
+std::vector<int> NearestMaskColumn(const std::vector<std::uint8_t>& mask, int width, const PixelBox& box) {
+  const auto in = [&](int u, int v) { return mask[static_cast<std::size_t>(v) * width + u] != 0; };
+  std::vector<int> nearest(static_cast<std::size_t>(box.width()) * (box.v1 - box.v0 + 1), kFar);
+  for (int v = box.v0; v <= box.v1; ++v) {
+    int* row = nearest.data() + static_cast<std::size_t>(v - box.v0) * box.width();
+    int last = -kFar;
+    for (int u = box.u0; u <= box.u1; ++u) {
+      if (in(u, v)) last = u;
+      row[u - box.u0] = std::min(kFar, u - last);
+    }
+    last = 2 * kFar;
+    for (int u = box.u1; u >= box.u0; --u) {
+      if (in(u, v)) last = u;
+      row[u - box.u0] = std::min(row[u - box.u0], last - u);
+    }
+  }
+  return nearest;
+}
+
+// half_width[dv] = floor(sqrt(k^2 - dv^2)): the disc of radius k's half width at row offset dv.
+std::vector<int> DiscHalfWidths(int k) {
+  std::vector<int> half_width(static_cast<std::size_t>(k) + 1);
+  for (int dv = 0; dv <= k; ++dv) {
+    int w = 0;
+    while ((w + 1) * (w + 1) + dv * dv <= k * k) ++w;
+    half_width[static_cast<std::size_t>(dv)] = w;
+  }
+  return half_width;
+}
+
+}  // namespace
+
 long BleedMask(int width, int height, int pixels, std::vector<std::uint8_t>* mask,
                std::uint8_t value) {
   if (!mask || width < 0 || height < 0 ||
@@ -155,54 +215,21 @@ long BleedMask(int width, int height, int pixels, std::vector<std::uint8_t>* mas
   if (pixels == 0 || value == 0) return 0;
   // Exact Euclidean dilation, row by row: (u, v) is within `pixels` of a mask
   // pixel iff for some row offset dv the nearest mask pixel in row v + dv is
-  // within floor(sqrt(k^2 - dv^2)) columns. Nearest mask column to the left
-  // and right of every pixel, per row: two O(width) passes.
-  // Only the mask's bounding box grown by k can change.
-  int u0 = width, v0 = height, u1 = -1, v1 = -1;
-  for (int v = 0; v < height; ++v) {
-    const std::uint8_t* row = mask->data() + static_cast<std::size_t>(v) * width;
-    for (int u = 0; u < width; ++u) {
-      if (!row[u]) continue;
-      u0 = std::min(u0, u), u1 = std::max(u1, u);
-      v0 = std::min(v0, v), v1 = std::max(v1, v);
-    }
-  }
-  if (u1 < 0) return 0;
-  u0 = std::max(0, u0 - pixels), u1 = std::min(width - 1, u1 + pixels);
-  v0 = std::max(0, v0 - pixels), v1 = std::min(height - 1, v1 + pixels);
-  const int box_width = u1 - u0 + 1;
+  // within floor(sqrt(k^2 - dv^2)) columns. Only the mask's bounding box grown
+  // by k can change.
+  const PixelBox box = GrownMaskBox(*mask, width, height, pixels);
+  if (box.u1 < box.u0) return 0;
   const std::vector<std::uint8_t> original = *mask;
-  const auto in = [&](int u, int v) { return original[static_cast<std::size_t>(v) * width + u] != 0; };
-  constexpr int kFar = 1 << 29;
-  // nearest[(v - v0) * box_width + (u - u0)] = |u - nearest mask column in row v|.
-  std::vector<int> nearest(static_cast<std::size_t>(box_width) * (v1 - v0 + 1), kFar);
-  for (int v = v0; v <= v1; ++v) {
-    int* row = nearest.data() + static_cast<std::size_t>(v - v0) * box_width;
-    int last = -kFar;
-    for (int u = u0; u <= u1; ++u) {
-      if (in(u, v)) last = u;
-      row[u - u0] = std::min(kFar, u - last);
-    }
-    last = 2 * kFar;
-    for (int u = u1; u >= u0; --u) {
-      if (in(u, v)) last = u;
-      row[u - u0] = std::min(row[u - u0], last - u);
-    }
-  }
-  std::vector<int> half_width(static_cast<std::size_t>(pixels) + 1);
-  for (int dv = 0; dv <= pixels; ++dv) {
-    int w = 0;
-    while ((w + 1) * (w + 1) + dv * dv <= pixels * pixels) ++w;
-    half_width[static_cast<std::size_t>(dv)] = w;
-  }
+  const std::vector<int> nearest = NearestMaskColumn(original, width, box);
+  const std::vector<int> half_width = DiscHalfWidths(pixels);
   long added = 0;
-  for (int v = v0; v <= v1; ++v) {
-    for (int u = u0; u <= u1; ++u) {
-      if (in(u, v)) continue;
+  for (int v = box.v0; v <= box.v1; ++v) {
+    for (int u = box.u0; u <= box.u1; ++u) {
+      if (original[static_cast<std::size_t>(v) * width + u]) continue;
       for (int dv = -pixels; dv <= pixels; ++dv) {
         const int nv = v + dv;
-        if (nv < v0 || nv > v1) continue;
-        if (nearest[static_cast<std::size_t>(nv - v0) * box_width + (u - u0)] <=
+        if (nv < box.v0 || nv > box.v1) continue;
+        if (nearest[static_cast<std::size_t>(nv - box.v0) * box.width() + (u - box.u0)] <=
             half_width[static_cast<std::size_t>(std::abs(dv))]) {
           (*mask)[static_cast<std::size_t>(v) * width + u] = value;
           ++added;
