@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""The docs match the code: every source path, C++ name and command-line
+option that the docs name exists.
+
+  check_docs.py C3PO_EXE SOURCE_DIR [DOC ...]
+  (default docs: README.md, docs/*.md, annotations/README.md, plugins/*/README.md)
+
+Checked, per doc line (the message names FILE:LINE and the item):
+- paths in backticks or markdown links whose first folder is one of the
+  repository's (libc3po, cli, tests, ...), a libc3po layer or a plugin, or
+  c3po/ (the include prefix): a file whose path ends with it, or a file of
+  that name below its folders in that order (`method/free_space.cpp`), or a
+  path a CMake file names (generated: c3po/base/version.hpp);
+- CamelCase names in backticks (`CheckWeakMotion`, `GlobalUniquenessOptions::reestimate`):
+  the name (the last part) is a word of the C++ or CMake sources;
+- options after `c3po COMMAND [SUBCOMMAND]`: listed by that command's --help;
+  an option in backticks elsewhere (`--reestimate`): listed by some command's.
+Exit 0 when all exist, 1 with one line per missing item, 2 on bad usage.
+"""
+import os
+import re
+import subprocess
+import sys
+
+SKIP_DIRS = {".git", "node_modules", ".cache"}
+SOURCE_EXT = (".hpp", ".cpp", ".h", ".sh", ".py", ".cmake", ".txt", ".js", ".in")
+
+
+def repo_files(root):
+    files = []
+    for folder, dirs, names in os.walk(root):
+        dirs[:] = [d for d in dirs if d not in SKIP_DIRS and not d.startswith("build")]
+        for name in names:
+            files.append(os.path.relpath(os.path.join(folder, name), root).replace(os.sep, "/"))
+    return files
+
+
+def first_folders(root, files):
+    """Folder names a checked path may start with."""
+    top = {f.split("/")[0] for f in files if "/" in f}
+    layers = {f.split("/")[1] for f in files if f.startswith(("libc3po/", "plugins/")) and f.count("/") >= 2}
+    return top | layers | {"c3po"}
+
+
+def in_order(wanted, folders):
+    it = iter(folders)
+    return all(w in it for w in wanted)
+
+
+def path_exists(path, files, cmake_text):
+    parts = path.split("/")
+    for f in files:
+        if f == path or f.endswith("/" + path):
+            return True
+        have = f.split("/")
+        if have[-1] == parts[-1] and in_order(parts[:-1], have[:-1]):
+            return True
+    return path in cmake_text
+
+
+def check_paths(doc, lineno, line, files, folders, cmake_text, report):
+    spans = re.findall(r"`([^`\s]+)`", line) + re.findall(r"\]\(([^)\s#]+)", line)
+    for span in spans:
+        span = span.rstrip(".,:;")
+        if "/" not in span or not span.endswith(SOURCE_EXT + (".md",)):
+            continue
+        if span.split("/")[0] not in folders or "*" in span or "<" in span:
+            continue
+        if not path_exists(span, files, cmake_text):
+            report(doc, lineno, f"names `{span}`, which is not a file of the repository")
+
+
+def check_names(doc, lineno, line, code_words, report):
+    for span in re.findall(r"`([A-Z][A-Za-z0-9]*[a-z0-9][A-Z][A-Za-z0-9]*(?:::[A-Za-z_][A-Za-z0-9_]*)?)(?:\(\))?`", line):
+        name = span.split("::")[-1]
+        if name not in code_words:
+            report(doc, lineno, f"names `{span}`, which no C++ or CMake source defines or uses")
+
+
+def subcommands(help_text):
+    """The names listed under "Subcommands:" in a CLI11 help text."""
+    section = help_text.split("Subcommands:", 1)[1].split("\n\n", 1)[0] if "Subcommands:" in help_text else ""
+    return set(re.findall(r"^  ([a-z][a-z-]*) ", section, re.M))
+
+
+class Commands:
+    def __init__(self, exe):
+        self.exe = exe
+        self.helps = {}
+        top = self.help([])
+        if top is None:
+            sys.exit(f"check_docs.py: {exe}: --help failed")
+        self.commands = subcommands(top)
+        self.bench = subcommands(self.help(["bench"]) or "") if "bench" in self.commands else set()
+
+    def help(self, words):
+        key = " ".join(words)
+        if key not in self.helps:
+            run = subprocess.run([self.exe] + words + ["--help"], capture_output=True, text=True)
+            self.helps[key] = run.stdout if run.returncode == 0 else None
+        return self.helps[key]
+
+    def every_option(self):
+        """The options of every command and bench subcommand."""
+        known = set()
+        for command in self.commands:
+            known |= self.options([command]) or set()
+        for bench in self.bench:
+            known |= self.options(["bench", bench]) or set()
+        return known
+
+    def options(self, words):
+        text = self.help(words)
+        return None if text is None else set(re.findall(r"--[a-z0-9][a-z0-9-]*", text))
+
+
+def check_options(doc, lineno, line, commands, report):
+    for match in re.finditer(r"(?<![\w/.-])c3po ([a-z][a-z-]*)(?: ([a-z][a-z-]*))?([^`|;&#]*)", line):
+        command, word, rest = match.group(1), match.group(2), match.group(3)
+        if command not in commands.commands:
+            continue
+        words = [command]
+        if command == "bench" and word in commands.bench:
+            words.append(word)
+        elif word:
+            rest = " " + word + rest
+        known = commands.options(words)
+        if known is None:
+            report(doc, lineno, f"`c3po {' '.join(words)} --help` fails")
+            continue
+        for option in re.findall(r"(?<![\w-])--[a-z0-9][a-z0-9-]*", rest):
+            if option not in known:
+                report(doc, lineno, f"gives `c3po {' '.join(words)}` the option {option}, which its --help does not list")
+
+
+def check_named_options(doc, lineno, line, every_option, report):
+    for span in re.findall(r"`(--[a-z0-9][a-z0-9-]*)[^`]*`", line):
+        if span not in every_option:
+            report(doc, lineno, f"names the option {span}, which no command's --help lists")
+
+
+def default_docs(root):
+    """README.md, docs/*.md and the READMEs of annotations/ and each plugin (not
+    CHANGELOG.md, which keeps old names, nor third_party_notes/, which name the
+    libraries' own APIs)."""
+    docs = [os.path.join(root, "README.md"), os.path.join(root, "annotations", "README.md")]
+    docs += sorted(os.path.join(root, "docs", n) for n in os.listdir(os.path.join(root, "docs")) if n.endswith(".md"))
+    plugins = os.path.join(root, "plugins")
+    docs += sorted(os.path.join(plugins, n, "README.md") for n in os.listdir(plugins)
+                   if os.path.isfile(os.path.join(plugins, n, "README.md")))
+    return docs
+
+
+def main(argv):
+    if len(argv) < 3:
+        print("usage: check_docs.py C3PO_EXE SOURCE_DIR [DOC ...]", file=sys.stderr)
+        return 2
+    exe, root = argv[1], os.path.abspath(argv[2])
+    docs = argv[3:] or default_docs(root)
+    files = repo_files(root)
+    folders = first_folders(root, files)
+    sources = [f for f in files if f.endswith((".hpp", ".cpp", ".h", ".cmake", ".in")) or f.endswith("CMakeLists.txt")]
+    code_text = "\n".join(open(os.path.join(root, f), errors="replace").read() for f in sources)
+    cmake_text = "\n".join(open(os.path.join(root, f), errors="replace").read()
+                           for f in sources if f.endswith((".cmake", "CMakeLists.txt")))
+    code_words = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", code_text))
+    commands = Commands(exe)
+    every_option = commands.every_option()
+    problems = []
+
+    def report(doc, lineno, what):
+        name = os.path.relpath(doc, root)
+        problems.append(f"{doc if name.startswith('..') else name}:{lineno}: {what}")
+
+    for doc in docs:
+        with open(doc, errors="replace") as stream:
+            for lineno, line in enumerate(stream, 1):
+                check_paths(doc, lineno, line, files, folders, cmake_text, report)
+                check_names(doc, lineno, line, code_words, report)
+                check_options(doc, lineno, line, commands, report)
+                check_named_options(doc, lineno, line, every_option, report)
+    for problem in problems:
+        print(problem)
+    print(f"check_docs.py: {len(docs)} docs, {len(problems)} items that do not exist", file=sys.stderr)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
