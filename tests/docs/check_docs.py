@@ -13,6 +13,9 @@ Checked, per doc line (the message names FILE:LINE and the item):
   path a CMake file names (generated: c3po/base/version.hpp);
 - CamelCase names in backticks (`CheckWeakMotion`, `GlobalUniquenessOptions::reestimate`):
   the name (the last part) is a word of the C++ or CMake sources;
+- snake_case names in backticks (JSON keys such as `free_space_shift_px`,
+  fields, test names): a word of the sources or scripts, a file's name
+  without extension, or a word of the doc's own fenced examples;
 - options after `c3po COMMAND [SUBCOMMAND]`: listed by that command's --help;
   an option in backticks elsewhere (`--reestimate`): listed by some command's.
 Exit 0 when all exist, 1 with one line per missing item, 2 on bad usage.
@@ -75,6 +78,19 @@ def check_names(doc, lineno, line, code_words, report):
         name = span.split("::")[-1]
         if name not in code_words:
             report(doc, lineno, f"names `{span}`, which no C++ or CMake source defines or uses")
+
+
+def check_keys(doc, lineno, line, known_words, report):
+    """snake_case names in backticks: JSON keys, fields, test names."""
+    for span in re.findall(r"`([a-z][a-z0-9]*(?:_[a-z0-9]+)+)`", line):
+        if span not in known_words:
+            report(doc, lineno, f"names `{span}`, which no source, file name or example of the doc has")
+
+
+def example_words(text):
+    """Words of a doc's fenced examples (folders and files the examples make)."""
+    blocks = re.findall(r"^```[^\n]*\n(.*?)^```", text, re.M | re.S)
+    return set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", "\n".join(blocks)))
 
 
 def subcommands(help_text):
@@ -164,6 +180,10 @@ def main(argv):
     cmake_text = "\n".join(open(os.path.join(root, f), errors="replace").read()
                            for f in sources if f.endswith((".cmake", "CMakeLists.txt")))
     code_words = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", code_text))
+    scripts = [f for f in files if f.endswith((".sh", ".py", ".js"))]
+    script_text = "\n".join(open(os.path.join(root, f), errors="replace").read() for f in scripts)
+    stems = {os.path.splitext(f.split("/")[-1])[0] for f in files}
+    source_words = code_words | set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", script_text)) | stems
     commands = Commands(exe)
     every_option = commands.every_option()
     problems = []
@@ -174,11 +194,14 @@ def main(argv):
 
     for doc in docs:
         with open(doc, errors="replace") as stream:
-            for lineno, line in enumerate(stream, 1):
-                check_paths(doc, lineno, line, files, folders, cmake_text, report)
-                check_names(doc, lineno, line, code_words, report)
-                check_options(doc, lineno, line, commands, report)
-                check_named_options(doc, lineno, line, every_option, report)
+            text = stream.read()
+        known_words = source_words | example_words(text)
+        for lineno, line in enumerate(text.splitlines(), 1):
+            check_paths(doc, lineno, line, files, folders, cmake_text, report)
+            check_names(doc, lineno, line, code_words, report)
+            check_keys(doc, lineno, line, known_words, report)
+            check_options(doc, lineno, line, commands, report)
+            check_named_options(doc, lineno, line, every_option, report)
     for problem in problems:
         print(problem)
     print(f"check_docs.py: {len(docs)} docs, {len(problems)} items that do not exist", file=sys.stderr)
