@@ -493,6 +493,48 @@ SelfTrainEpochLog EpochLog(int epoch, const EpochStats& stats, const ValidationF
   return log;
 }
 
+// A fresh run: the detector as given is the initial and best fit.
+ResumePoint Start(const ValidationFit& initial, const TrainableDetector& detector, SelfTrainResult* result,
+                  std::vector<float>* best_weights) {
+  result->initial = initial;
+  result->best = initial;
+  result->initial_validation_percent_oc = initial.percent_oc;
+  result->best_validation_percent_oc = initial.percent_oc;
+  result->best_validation_detection_error = initial.detection_error;
+  *best_weights = detector.GetWeights();
+  return ResumePoint{};
+}
+
+// A resumed run: the checkpoint's weights, state and best weights.
+ResumePoint Resume(const SelfTrainOptions& options, std::size_t clouds, TrainableDetector& detector,
+                   SelfTrainResult* result, std::vector<float>* best_weights) {
+  const std::string& where = options.checkpoint_path;
+  const ResumePoint at = ReadCheckpointState(where, detector.LoadCheckpoint(where), clouds, result);
+  *best_weights = LoadWeights(where + ".best", detector.GetWeights().size());
+  return at;
+}
+
+// After an epoch: a better held-out fit becomes the best (its weights kept); a worse one rolls the
+// detector back to the best weights (returns true). `stale` counts the epochs since the last best.
+bool KeepOrRollBack(const ValidationFit& fit, int epoch, const SelfTrainOptions& options,
+                    TrainableDetector& detector, SelfTrainResult* result, std::vector<float>* best_weights,
+                    int* stale) {
+  const double eps_oc = options.pipeline.certificate.eps_oc;
+  if (Better(fit, result->best, options.residual_tolerance, eps_oc)) {
+    result->best = fit;
+    result->best_validation_percent_oc = fit.percent_oc;
+    result->best_validation_detection_error = fit.detection_error;
+    result->best_epoch = epoch;
+    *best_weights = detector.GetWeights();
+    *stale = 0;
+    return false;
+  }
+  ++*stale;
+  if (!Worse(fit, result->best, options.residual_tolerance, eps_oc)) return false;
+  detector.SetWeights(*best_weights);   // roll back: continue from the best epoch
+  return true;
+}
+
 }  // namespace
 
 SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>& clouds,
@@ -514,21 +556,11 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
   SelfTrainResult result;
   result.pseudo_label_uses.assign(clouds.size(), 0);
   std::vector<float> best_weights;
-  ResumePoint at;
-  if (resume && !options.checkpoint_path.empty() && std::filesystem::exists(options.checkpoint_path)) {
-    const std::string& where = options.checkpoint_path;
-    at = ReadCheckpointState(where, detector.LoadCheckpoint(where), clouds.size(), &result);
-    best_weights = LoadWeights(options.checkpoint_path + ".best", detector.GetWeights().size());
-  } else {
-    result.initial = measure();
-    result.best = result.initial;
-    result.initial_validation_percent_oc = result.initial.percent_oc;
-    result.best_validation_percent_oc = result.initial.percent_oc;
-    result.best_validation_detection_error = result.initial.detection_error;
-    best_weights = detector.GetWeights();
-  }
+  const bool resuming =
+      resume && !options.checkpoint_path.empty() && std::filesystem::exists(options.checkpoint_path);
+  const ResumePoint at = resuming ? Resume(options, clouds.size(), detector, &result, &best_weights)
+                                  : Start(measure(), detector, &result, &best_weights);
 
-  const double eps_oc = options.pipeline.certificate.eps_oc;
   const std::size_t progress_total = train.size() * static_cast<std::size_t>(options.epochs);
   int stale = at.stale;   // epochs in a row without a new best
   for (int epoch = at.first_epoch; epoch <= options.epochs; ++epoch) {
@@ -549,20 +581,7 @@ SelfTrainResult SelfTrain(const ObjectModel& object, const std::vector<PointSet>
     }
     const ValidationFit fit = measure();
     SelfTrainEpochLog log = EpochLog(epoch, stats, fit);
-    if (Better(fit, result.best, options.residual_tolerance, eps_oc)) {
-      result.best = fit;
-      result.best_validation_percent_oc = fit.percent_oc;
-      result.best_validation_detection_error = fit.detection_error;
-      result.best_epoch = epoch;
-      best_weights = detector.GetWeights();
-      stale = 0;
-    } else {
-      ++stale;
-      if (Worse(fit, result.best, options.residual_tolerance, eps_oc)) {
-        detector.SetWeights(best_weights);   // roll back: continue from the best epoch
-        log.rolled_back = true;
-      }
-    }
+    log.rolled_back = KeepOrRollBack(fit, epoch, options, detector, &result, &best_weights, &stale);
     log.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.epochs.push_back(log);
     if (!options.checkpoint_path.empty()) WriteCheckpoint(options, result, epoch, stale, best_weights, detector);
