@@ -211,68 +211,73 @@ std::unique_ptr<DepthRenderer> BopSceneGenerator::MakeRenderer() const {
   return std::make_unique<DepthRenderer>(options_.camera);
 }
 
+std::optional<BopSceneGenerator::Arrangement> BopSceneGenerator::Arrange(Rng& rng) const {
+  Arrangement scene;
+  std::vector<Eigen::Vector3d> centres;
+  const auto place = [&](const Placed& object) {
+    const Pose pose = SamplePose(options_.pose, options_.camera, distance_, object.centre, object.diameter,
+                                 CloudKind::kDepth, rng);
+    const Eigen::Vector3d centre = pose * object.centre;
+    for (std::size_t j = 0; j < scene.instances.size(); ++j) {
+      const double clearance = 0.5 * (object.diameter + scene.placed[j]->diameter);
+      if ((centre - centres[j]).norm() < clearance) return false;
+    }
+    scene.instances.push_back({object.object.mesh, pose, object.closed});
+    centres.push_back(centre);
+    return true;
+  };
+  scene.placed.push_back(&objects_[0]);
+  place(objects_[0]);
+  for (int k = 0; k < options_.distractors; ++k) {
+    const std::size_t choice =
+        objects_.size() == 1 ? 0
+                             : 1 + static_cast<std::size_t>(rng.UniformInt(static_cast<int>(objects_.size() - 1)));
+    const Placed& object = objects_[choice];
+    scene.placed.push_back(&object);
+    bool ok = false;
+    for (int draw = 0; draw < 20 && !ok; ++draw) ok = place(object);
+    if (!ok) return std::nullopt;   // no room for this distractor: draw the scene again
+  }
+  return scene;
+}
+
+namespace {
+
+// The target's visible pixels pass the options' count and fraction of its silhouette.
+bool TargetVisibleEnough(const SceneImage& scene, const BopSynthOptions& options) {
+  const std::vector<int> visible = scene.VisiblePixels(0);
+  const double fraction = scene.silhouettes[0].empty() ? 0.0
+                                                        : static_cast<double>(visible.size()) /
+                                                              static_cast<double>(scene.silhouettes[0].size());
+  return static_cast<int>(visible.size()) >= options.min_visible_pixels && fraction >= options.min_visib_fract;
+}
+
+}  // namespace
+
 SynthBopImage BopSceneGenerator::Generate(std::size_t index, DepthRenderer* renderer) const {
   if (!renderer) throw std::invalid_argument("BopSceneGenerator: needs a renderer");
-  const CameraIntrinsics& camera = options_.camera;
   Rng rng = Rng::ForItem(options_.seed, index);
-  const Placed& target = objects_[0];
   for (int attempt = 1; attempt <= options_.max_attempts; ++attempt) {
-    // Instances: the target, then distractors whose bounding spheres keep
-    // clear of every instance placed before (up to 20 draws each).
-    std::vector<const Placed*> placed{&target};
-    std::vector<SceneInstance> instances;
-    std::vector<Eigen::Vector3d> centres;
-    const auto place = [&](const Placed& object) {
-      const Pose pose = SamplePose(options_.pose, camera, distance_, object.centre, object.diameter,
-                                   CloudKind::kDepth, rng);
-      const Eigen::Vector3d centre = pose * object.centre;
-      for (std::size_t j = 0; j < instances.size(); ++j) {
-        const double clearance = 0.5 * (object.diameter + placed[j]->diameter);
-        if ((centre - centres[j]).norm() < clearance) return false;
-      }
-      instances.push_back({object.object.mesh, pose, object.closed});
-      centres.push_back(centre);
-      return true;
-    };
-    place(target);
-    bool complete = true;
-    for (int k = 0; k < options_.distractors && complete; ++k) {
-      const std::size_t choice =
-          objects_.size() == 1 ? 0
-                               : 1 + static_cast<std::size_t>(rng.UniformInt(static_cast<int>(objects_.size() - 1)));
-      const Placed& object = objects_[choice];
-      placed.push_back(&object);
-      bool ok = false;
-      for (int draw = 0; draw < 20 && !ok; ++draw) ok = place(object);
-      if (!ok) complete = false;
-    }
-    if (!complete) continue;
+    const std::optional<Arrangement> drawn = Arrange(rng);
+    if (!drawn) continue;
     std::optional<Plane> table;
     if (options_.background) {
       const double tilt = rng.Uniform(0.0, options_.max_table_tilt);
-      table = TablePlane(instances, tilt, options_.background_gap * target.diameter);
+      table = TablePlane(drawn->instances, tilt, options_.background_gap * objects_[0].diameter);
     }
-    SceneImage scene = RenderScene(*renderer, instances, table);
-    const std::vector<int> target_visible = scene.VisiblePixels(0);
-    const double target_fract =
-        scene.silhouettes[0].empty()
-            ? 0.0
-            : static_cast<double>(target_visible.size()) / static_cast<double>(scene.silhouettes[0].size());
-    if (static_cast<int>(target_visible.size()) < options_.min_visible_pixels ||
-        target_fract < options_.min_visib_fract) {
-      continue;
-    }
+    const SceneImage scene = RenderScene(*renderer, drawn->instances, table);
+    if (!TargetVisibleEnough(scene, options_)) continue;
 
     SynthBopImage image;
     image.scene_id = static_cast<int>(index / static_cast<std::size_t>(options_.images_per_scene));
     image.im_id = static_cast<int>(index % static_cast<std::size_t>(options_.images_per_scene));
-    image.width = camera.width;
-    image.height = camera.height;
+    image.width = options_.camera.width;
+    image.height = options_.camera.height;
     image.attempts = attempt;
     WriteDepth(options_, scene, index, &image);
-    for (std::size_t i = 0; i < instances.size(); ++i) {
-      image.instances.push_back(InstanceRecord(options_, scene, static_cast<int>(i), placed[i]->object.obj_id,
-                                               instances[i].camera_from_model, &image));
+    for (std::size_t i = 0; i < drawn->instances.size(); ++i) {
+      image.instances.push_back(InstanceRecord(options_, scene, static_cast<int>(i), drawn->placed[i]->object.obj_id,
+                                               drawn->instances[i].camera_from_model, &image));
     }
     return image;
   }

@@ -30,9 +30,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "c3po/base/random.hpp"
 #include "c3po/synth/depth_artefacts.hpp"
 #include "c3po/geometry/mesh.hpp"
 #include "c3po/geometry/render.hpp"
@@ -123,7 +125,14 @@ class BopSceneGenerator {
     double diameter = 0.0;
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();   // bounding-box centre, model frame
   };
+  // One draw of the scene's instances: the target, then distractors whose
+  // bounding spheres keep clear of every instance placed before.
+  struct Arrangement {
+    std::vector<const Placed*> placed;   // [i] = the object of instances[i]
+    std::vector<SceneInstance> instances;
+  };
   Placed Prepare(const SynthBopObject& object) const;
+  std::optional<Arrangement> Arrange(Rng& rng) const;
 
   BopSynthOptions options_;
   std::string where_;
