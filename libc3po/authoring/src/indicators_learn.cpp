@@ -226,6 +226,68 @@ std::string AutoIndicatorResult::EvidenceJson() const {
   return doc.dump();
 }
 
+namespace {
+
+// Renders and labels every view (the deliberate ones, the random training and test views) on both
+// cores into result->deliberate_labels, training_views and test_views.
+void LabelViews(const ObjectModel& object, const ViewSamplingOptions& training, const ViewSamplingOptions& test,
+                const DegeneracyOptions& degeneracy, const IndicatorProgress& progress, AutoIndicatorResult* result) {
+  const std::vector<Pose> motions = DegeneracySearchMotions(object);
+  const int random_start = static_cast<int>(result->deliberate_views.size());
+  const int test_start = random_start + training.views;
+  const int total = test_start + test.views;
+  result->deliberate_labels.resize(random_start);
+  result->training_views.resize(training.views);
+  result->test_views.resize(test.views);
+  RendererPool pool(training.camera);
+  std::atomic<std::size_t> done{0};
+  ParallelFor(0, total, [&](int item) {
+    ThrowIfInterrupted();
+    auto renderer = pool.Take();
+    RenderedView view;
+    ViewDegeneracy* label = nullptr;
+    if (item < random_start) {
+      view = RenderDeliberateView(object, training, result->noise_sigma, result->deliberate_views[item], item,
+                                  renderer.get());
+      label = &result->deliberate_labels[item];
+    } else if (item < test_start) {
+      view = RenderView(object, training, result->noise_sigma, item - random_start, renderer.get());
+      label = &result->training_views[item - random_start];
+    } else {
+      view = RenderView(object, test, result->noise_sigma, item - test_start, renderer.get());
+      label = &result->test_views[item - test_start];
+    }
+    pool.Give(std::move(renderer));
+    *label = AnalyzeViewDegeneracy(object, view.cloud, view.camera_from_model, motions, degeneracy);
+    const std::size_t finished = ++done;
+    if (progress) progress(finished, static_cast<std::size_t>(total));
+  });
+}
+
+// Learns the sets from the usable training labels (with the deliberate views when options.deliberate)
+// and scores them, and the object's current sets, on the test and deliberate views.
+void LearnAndScore(const ObjectModel& object, const AutoIndicatorOptions& options, double borderline,
+                   AutoIndicatorResult* result) {
+  std::vector<LabelledView> training_labels =
+      UsableLabels(result->training_views, borderline, &result->unusable_training_views);
+  const std::vector<LabelledView> test_labels =
+      UsableLabels(result->test_views, borderline, &result->unusable_test_views);
+  const std::vector<LabelledView> deliberate_labels =
+      UsableLabels(result->deliberate_labels, borderline, &result->unusable_deliberate_views);
+  if (options.deliberate) {
+    training_labels.insert(training_labels.begin(), deliberate_labels.begin(), deliberate_labels.end());
+  }
+  result->learned = LearnIndicatorSets(training_labels, object.num_keypoints(), options.learning);
+  result->training_score = ScoreIndicatorSets(result->learned.sets, training_labels);
+  result->test_score = ScoreIndicatorSets(result->learned.sets, test_labels);
+  result->current_test_score = ScoreIndicatorSets(object.spec().indicator_sets, test_labels);
+  result->deliberate_score = ScoreIndicatorSets(result->learned.sets, deliberate_labels);
+  result->current_deliberate_score = ScoreIndicatorSets(object.spec().indicator_sets, deliberate_labels);
+  result->deliberate_trained = options.deliberate;
+}
+
+}  // namespace
+
 AutoIndicatorResult LearnIndicatorSetsFromViews(const ObjectModel& object,
                                                 const AutoIndicatorOptions& options,
                                                 const IndicatorProgress& progress) {
@@ -238,63 +300,20 @@ AutoIndicatorResult LearnIndicatorSetsFromViews(const ObjectModel& object,
   result.eps_oc = degeneracy.eps_oc;
   result.delta_nd = degeneracy.delta_nd;
   result.noise_sigma = options.training.noise_sigma >= 0 ? options.training.noise_sigma : degeneracy.eps_oc / 8.0;
-  ViewSamplingOptions training = options.training;
+  const ViewSamplingOptions& training = options.training;
   ViewSamplingOptions test = options.training;
   test.seed = options.test_seed != 0 ? options.test_seed : training.seed + 1000003;
   if (options.test_views > 0) test.views = options.test_views;
   result.training_seed = training.seed;
   result.test_seed = test.seed;
 
-  const std::vector<Pose> motions = DegeneracySearchMotions(object);
   // The deliberate (face-on, edge-on, corner, partial) views are always
   // labelled and scored; with options.deliberate they are training views too.
   // Test views are random only.
   result.deliberate_views = DeliberateViews(object, options.deliberate_views);
-  const int deliberate = static_cast<int>(result.deliberate_views.size());
-  const int random_start = deliberate;
-  const int test_start = random_start + training.views;
-  const int total = test_start + test.views;
-  result.deliberate_labels.resize(deliberate);
-  result.training_views.resize(training.views);
-  result.test_views.resize(test.views);
-  RendererPool pool(training.camera);
-  std::atomic<std::size_t> done{0};
-  ParallelFor(0, total, [&](int item) {
-    ThrowIfInterrupted();
-    auto renderer = pool.Take();
-    RenderedView view;
-    ViewDegeneracy* label = nullptr;
-    if (item < random_start) {
-      view = RenderDeliberateView(object, training, result.noise_sigma, result.deliberate_views[item], item,
-                                  renderer.get());
-      label = &result.deliberate_labels[item];
-    } else if (item < test_start) {
-      view = RenderView(object, training, result.noise_sigma, item - random_start, renderer.get());
-      label = &result.training_views[item - random_start];
-    } else {
-      view = RenderView(object, test, result.noise_sigma, item - test_start, renderer.get());
-      label = &result.test_views[item - test_start];
-    }
-    pool.Give(std::move(renderer));
-    *label = AnalyzeViewDegeneracy(object, view.cloud, view.camera_from_model, motions, degeneracy);
-    const std::size_t finished = ++done;
-    if (progress) progress(finished, static_cast<std::size_t>(total));
-  });
-
+  LabelViews(object, training, test, degeneracy, progress, &result);
   const double borderline = options.learning.borderline_factor * degeneracy.tolerance_factor * degeneracy.eps_oc;
-  std::vector<LabelledView> training_labels =
-      UsableLabels(result.training_views, borderline, &result.unusable_training_views);
-  const std::vector<LabelledView> test_labels = UsableLabels(result.test_views, borderline, &result.unusable_test_views);
-  const std::vector<LabelledView> deliberate_labels =
-      UsableLabels(result.deliberate_labels, borderline, &result.unusable_deliberate_views);
-  if (options.deliberate) training_labels.insert(training_labels.begin(), deliberate_labels.begin(), deliberate_labels.end());
-  result.learned = LearnIndicatorSets(training_labels, object.num_keypoints(), options.learning);
-  result.training_score = ScoreIndicatorSets(result.learned.sets, training_labels);
-  result.test_score = ScoreIndicatorSets(result.learned.sets, test_labels);
-  result.current_test_score = ScoreIndicatorSets(object.spec().indicator_sets, test_labels);
-  result.deliberate_score = ScoreIndicatorSets(result.learned.sets, deliberate_labels);
-  result.current_deliberate_score = ScoreIndicatorSets(object.spec().indicator_sets, deliberate_labels);
-  result.deliberate_trained = options.deliberate;
+  LearnAndScore(object, options, borderline, &result);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;
 }
