@@ -49,8 +49,8 @@ nlohmann::ordered_json SourceKeys(const CloudSource& source, const CloudOutcome&
   return line;
 }
 
-// The estimate keys, appended in the documented order.
-void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
+// The pose, the decisions, the paper's evidence, the corrector's and the re-estimation's keys.
+void AddPoseAndDecisionKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   nlohmann::ordered_json& line = *out;
   const Pose& T = e.scene_from_model;
   SetPoseJson(T, &line);
@@ -73,7 +73,11 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["restarts_tried"] = e.restarts_tried;
   line["restart_axis"] = e.restart_axis;
   line["restart_angle_deg"] = e.restart_angle_deg;
-  // Outlier-robust evidence (docs/method.md "Outlier-robust certificates").
+}
+
+// Outlier-robust evidence (docs/method.md "Outlier-robust certificates"): oc_m and nd_m's support and local test.
+void AddRobustKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
+  nlohmann::ordered_json& line = *out;
   const ObservableCorrectness& oc = e.certificate.oc;
   const NonDegeneracy& nd = e.certificate.nd;
   line["max_outliers"] = oc.max_outliers;
@@ -95,7 +99,11 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
                              nd.local.motion(3), nd.local.motion(4), nd.local.motion(5)};
   line["nd_local_rank"] = nd.local.model_rank;
   line["nd_local_weak_motions"] = nd.local.weak_motions;
-  // The finite check of a single weak motion (global_uniqueness.hpp); null when not run.
+}
+
+// The finite check of a single weak motion (global_uniqueness.hpp); null when not run.
+void AddWeakMotionKeys(const NonDegeneracy& nd, nlohmann::ordered_json* out) {
+  nlohmann::ordered_json& line = *out;
   const WeakMotionCheck& w = nd.weak_motion;
   line["nd_weak_motion"] = nd.weak_motion_checked ? nlohmann::ordered_json(w.passed) : nlohmann::ordered_json(nullptr);
   line["weak_motion_starts"] = w.starts;
@@ -103,7 +111,11 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["weak_motion_rival_step"] = w.rivals_found > 0 ? nlohmann::ordered_json(w.rival_step) : nlohmann::ordered_json(nullptr);
   line["weak_motion_rival_hausdorff"] =
       w.rivals_found > 0 ? nlohmann::ordered_json(w.rival_hausdorff) : nlohmann::ordered_json(nullptr);
-  // Global rival search (global_uniqueness.hpp); null when not run.
+}
+
+// Global rival search (global_uniqueness.hpp); null when not run.
+void AddRivalKeys(const NonDegeneracy& nd, nlohmann::ordered_json* out) {
+  nlohmann::ordered_json& line = *out;
   const GlobalUniqueness& g = nd.global;
   line["nd_global"] = nd.global_checked ? nlohmann::ordered_json(g.passed) : nlohmann::ordered_json(nullptr);
   line["rivals_tried"] = g.rivals_tried;
@@ -120,8 +132,11 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["rival_R"] = g.rival_axis >= 0 ? RotationJson(rival.R) : nlohmann::ordered_json(nullptr);
   line["rival_t"] = g.rival_axis >= 0 ? nlohmann::ordered_json({rival.t(0), rival.t(1), rival.t(2)})
                                       : nlohmann::ordered_json(nullptr);
-  // Free space (depth-image inputs, free_space.hpp); null when not checked.
-  const FreeSpace& f = e.certificate.free_space;
+}
+
+// Free space (depth-image inputs, free_space.hpp); null when not checked.
+void AddFreeSpaceKeys(const FreeSpace& f, nlohmann::ordered_json* out) {
+  nlohmann::ordered_json& line = *out;
   line["free_space"] = f.checked ? nlohmann::ordered_json(f.passed) : nlohmann::ordered_json(nullptr);
   line["free_space_violations"] = f.violations;
   line["free_space_measured"] = f.measured;
@@ -129,7 +144,16 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["free_space_tolerance"] = f.tolerance;
   line["free_space_shift_px"] = {f.shift_u, f.shift_v};
   line["through_support"] = f.support_checked ? nlohmann::ordered_json(f.through_support) : nlohmann::ordered_json(nullptr);
-  line["ms"] = e.milliseconds;
+}
+
+// Every key of an estimate, in the documented order.
+void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
+  AddPoseAndDecisionKeys(e, out);
+  AddRobustKeys(e, out);
+  AddWeakMotionKeys(e.certificate.nd, out);
+  AddRivalKeys(e.certificate.nd, out);
+  AddFreeSpaceKeys(e.certificate.free_space, out);
+  (*out)["ms"] = e.milliseconds;
 }
 
 }  // namespace
