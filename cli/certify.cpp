@@ -47,7 +47,7 @@ struct CertifyCommand {
   SegmentOptions segment;
   std::string bop_csv_path;
   std::string shard;
-  std::string poses_path;   // certify given poses (docs/method.md "Certifying given poses")
+  std::string poses_path;   // certify given poses (docs/method.md "Certifying poses from any estimator")
   ReportFlags report;       // --report, --views: the certify report (web/certify_report.hpp)
 };
 

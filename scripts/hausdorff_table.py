@@ -15,7 +15,7 @@ distance is exact when at most --correct; above it only "above" matters. For
 every file prints one Markdown row: instances, % certified, % certified and
 correct, false certificates (certified and not correct), % correct. Lines with
 an "error" count as not certified and not correct. Measurement only (standard
-library; no c3po code): docs/method.md "Self-training on real frames",
+library; no c3po code): docs/method.md "Self-training on camera frames",
 "Provocation on real frames".
 """
 import json

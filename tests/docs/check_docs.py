@@ -17,7 +17,10 @@ Checked, per doc line (the message names FILE:LINE and the item):
   fields, test names): a word of the sources or scripts, a file's name
   without extension, or a word of the doc's own fenced examples;
 - options after `c3po COMMAND [SUBCOMMAND]`: listed by that command's --help;
-  an option in backticks elsewhere (`--reestimate`): listed by some command's.
+  an option in backticks elsewhere (`--reestimate`): listed by some command's;
+- section references, in the docs and in every source, script and message
+  (docs/method.md "Weak motion"): that doc has a heading or a bold lead that
+  begins with the title.
 Exit 0 when all exist, 1 with one line per missing item, 2 on bad usage.
 """
 import os
@@ -167,6 +170,34 @@ def default_docs(root):
     return docs
 
 
+def section_titles(text):
+    """Headings (outside fenced examples) and bold leads of a doc."""
+    prose = re.sub(r"^```.*?^```", "", text, flags=re.M | re.S)
+    return [h.strip() for h in re.findall(r"^#+ (.*)$", prose, re.M)] + re.findall(r"\*\*([^*]+)\*\*", prose)
+
+
+def doc_titles(root, files):
+    titles = {}
+    for f in files:
+        if f.startswith("docs/") and f.endswith(".md"):
+            with open(os.path.join(root, f), errors="replace") as stream:
+                titles[f] = section_titles(stream.read())
+    return titles
+
+
+def check_sections(paths, titles, report):
+    """References such as docs/method.md "Weak motion" in the files at `paths`."""
+    reference = re.compile(r'(docs/[A-Za-z_]+\.md)[,:]?\s*\\?"([^"\\]+)\\?"')
+    for path in paths:
+        with open(path, errors="replace") as stream:
+            for lineno, line in enumerate(stream, 1):
+                for doc, title in reference.findall(line):
+                    if doc not in titles:
+                        report(path, lineno, f"refers to {doc}, which is not a doc of the repository")
+                    elif not any(t.startswith(title) for t in titles[doc]):
+                        report(path, lineno, f'refers to {doc} "{title}", which has no such section')
+
+
 def main(argv):
     if len(argv) < 3:
         print("usage: check_docs.py C3PO_EXE SOURCE_DIR [DOC ...]", file=sys.stderr)
@@ -202,6 +233,11 @@ def main(argv):
             check_keys(doc, lineno, line, known_words, report)
             check_options(doc, lineno, line, commands, report)
             check_named_options(doc, lineno, line, every_option, report)
+    # Section references: in the given docs, or (checking the repository) in every doc, source and script.
+    # (not tests/docs/: the check's own test writes references that must fail)
+    referring = docs if len(argv) > 3 else [os.path.join(root, f) for f in files
+                                            if f.endswith(SOURCE_EXT + (".md",)) and not f.startswith("tests/docs/")]
+    check_sections(referring, doc_titles(root, files), report)
     for problem in problems:
         print(problem)
     print(f"check_docs.py: {len(docs)} docs, {len(problems)} items that do not exist", file=sys.stderr)

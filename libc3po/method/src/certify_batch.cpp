@@ -15,7 +15,7 @@
 namespace c3po {
 namespace {
 
-// --eps-oc auto (docs/method.md "Automatic eps_oc"): eps_oc from the clouds
+// --eps-oc auto (docs/method.md "Automatic ε_oc"): eps_oc from the clouds
 // that were processed and the oc distances of their estimates, then both
 // certificates are decided again with it. With a budget m the distance used is
 // each cloud's (m+1)-th largest point distance (budget_distance: the m

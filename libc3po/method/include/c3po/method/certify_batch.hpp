@@ -3,7 +3,7 @@
 // -> EstimateAndCertify (pipeline.hpp) -> outcome" behind `c3po certify`,
 // `c3po eval` (evaluation.hpp) and self-training (selftrain.hpp), with
 // progress, parallelism over clouds (ParallelFor), cancellation (interrupt.hpp)
-// and the single `--eps-oc auto` decision (docs/method.md "Automatic eps_oc").
+// and the single `--eps-oc auto` decision (docs/method.md "Automatic ε_oc").
 //
 // A batch is a list of CloudSource: each yields a point cloud (read from a
 // file, a dataset entry, or already in memory) with its provenance and, when

@@ -1,6 +1,6 @@
 #pragma once
 // What self-training learns from when its clouds come from cameras (issue 18
-// part 3; docs/method.md "Self-training on real frames"): the CloudSources of
+// part 3; docs/method.md "Self-training on camera frames"): the CloudSources of
 // the one batch path (certify_batch.hpp, image_sources.hpp: --bop, --depth /
 // --mask, datasets), read into memory with the image each came from, then the
 // paper's augmentation (Section VIII-D): several copies of every real

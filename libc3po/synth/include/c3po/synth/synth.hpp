@@ -1,5 +1,5 @@
 #pragma once
-// Synthetic data (docs/method.md "Data the paper uses"): simulated clouds (uniform
+// Synthetic data (docs/method.md "Data"): simulated clouds (uniform
 // surface samples of the whole mesh) and rendered depth clouds (what a pinhole
 // depth camera sees), each with its ground-truth pose and posed keypoints.
 //
