@@ -31,7 +31,7 @@ python3 "$SRC/tests/docs/check_docs.py" "$EXE" "$SRC" "$WORK/planted.md" > "$WOR
 status=$?
 [ "$status" = 1 ] || fail "exit status $status, expected 1: $(cat "$WORK/err.txt")"
 for expected in 'planted.md:1: names `libc3po/method/src/no_such_step.cpp`' \
-                'planted.md:1: names `docs/nowhere.md`' \
+                'planted.md:1: names docs/nowhere.md, which is not a doc' \
                 'planted.md:2: names `NoSuchFunction`' \
                 'planted.md:3: gives `c3po certify` the option --no-such-option' \
                 'planted.md:4: gives `c3po bench corrector` the option --bogus-flag' \

@@ -1,6 +1,6 @@
 #pragma once
-// BOP datasets (Benchmark for 6D Object Pose Estimation; bop_toolkit's
-// docs/bop_datasets_format.md) as c3po inputs and outputs (issue 15,
+// BOP datasets (Benchmark for 6D Object Pose Estimation;
+// bop_toolkit/docs/bop_datasets_format.md) as c3po inputs and outputs (issue 15,
 // docs/camera_inputs.md):
 //  - a scene folder NNNNNN/ with scene_camera.json, depth/{im_id:06d}.png,
 //    mask_visib/ (or mask/) {im_id:06d}_{gt_id:06d}.png, optional

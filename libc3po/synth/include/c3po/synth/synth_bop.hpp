@@ -1,7 +1,7 @@
 #pragma once
 // Synthetic BOP datasets (docs/synth_bop.md): rendered scenes with known
-// truth in the layout of the BOP benchmark (bop_toolkit
-// docs/bop_datasets_format.md), with optional depth-sensor artefacts
+// truth in the layout of the BOP benchmark
+// (bop_toolkit/docs/bop_datasets_format.md), with optional depth-sensor artefacts
 // (depth_artefacts.hpp).
 //
 // Each image shows the target object (gt_id 0) and `distractors` further
