@@ -16,7 +16,8 @@ Checked, per doc line (the message names FILE:LINE and the item):
 - snake_case names in backticks (JSON keys such as `free_space_shift_px`,
   fields, test names): a word of the sources or scripts, a file's name
   without extension, or a word of the doc's own fenced examples;
-- options after `c3po COMMAND [SUBCOMMAND]`: listed by that command's --help;
+- options after `c3po COMMAND [SUBCOMMAND]`, in the docs and in the commands'
+  own --help examples: listed by that command's --help;
   an option in backticks elsewhere (`--reestimate`): listed by some command's;
 - docs named in the docs and in every source, script and message: they
   exist; section references (docs/method.md "Weak motion"): that doc has a
@@ -131,8 +132,14 @@ class Commands:
         return known
 
     def options(self, words):
+        """The options the help lists (the first column of its option lines, not its examples)."""
         text = self.help(words)
-        return None if text is None else set(re.findall(r"--[a-z0-9][a-z0-9-]*", text))
+        if text is None:
+            return None
+        names = set()
+        for first in re.findall(r"^ +(-\S+)", text, re.M):
+            names |= set(re.findall(r"--[a-z0-9][a-z0-9-]*", first))
+        return names
 
 
 def check_options(doc, lineno, line, commands, report):
@@ -224,7 +231,7 @@ def main(argv):
     problems = []
 
     def report(doc, lineno, what):
-        name = os.path.relpath(doc, root)
+        name = os.path.relpath(doc, root) if os.path.isabs(doc) else doc
         problems.append(f"{doc if name.startswith('..') else name}:{lineno}: {what}")
 
     for doc in docs:
@@ -237,6 +244,12 @@ def main(argv):
             check_keys(doc, lineno, line, known_words, report)
             check_options(doc, lineno, line, commands, report)
             check_named_options(doc, lineno, line, every_option, report)
+    if len(argv) == 3:   # the commands' own examples (the Example: lines of each --help)
+        for words in [[c] for c in sorted(commands.commands)] + [["bench", b] for b in sorted(commands.bench)]:
+            lines = (commands.help(words) or "").splitlines()
+            examples = next((i for i, line in enumerate(lines) if line.startswith("Example")), len(lines))
+            for lineno in range(examples + 1, len(lines) + 1):
+                check_options(f"c3po {' '.join(words)} --help", lineno, lines[lineno - 1], commands, report)
     # Section references: in the given docs, or (checking the repository) in every doc, source and script.
     # (not tests/docs/: the check's own test writes references that must fail)
     referring = docs if len(argv) > 3 else [os.path.join(root, f) for f in files
