@@ -61,4 +61,22 @@ inline ObjectModel AsymmetricObject(int sample_size = 4000) {
   return ObjectModel(spec, mesh, options);
 }
 
+// The paper's mug reduced to boxes: an 0.08 x 0.08 x 0.10 body and a small
+// side "handle" block; keypoint 0 is on the handle and alone is the indicator
+// set (eps_oc 1 cm, delta_nd 8 mm).
+inline Mesh MugLikeMesh() {
+  return MergeMeshes({BoxMesh({0, 0, 0}, {0.08, 0.08, 0.10}), BoxMesh({0.055, 0, 0}, {0.03, 0.02, 0.06})});
+}
+
+inline ObjectSpec MugLikeSpec() {
+  ObjectSpec spec;
+  spec.name = "mug-like";
+  spec.keypoints.resize(3, 3);
+  spec.keypoints << 0.07, -0.04, -0.04, 0.0, -0.04, 0.04, 0.0, 0.05, -0.05;
+  spec.indicator_sets = {{0}};
+  spec.eps_oc = 0.01;
+  spec.delta_nd = 0.008;
+  return spec;
+}
+
 }  // namespace c3po::test

@@ -122,15 +122,8 @@ TEST_CASE("non-degeneracy: a box seen face-on fails, three faces pass") {
 TEST_CASE("non-degeneracy: removing the handle's points flips nd") {
   // Body plus a small side 'handle' block; the handle keypoint alone is the
   // indicator set (the paper's mug).
-  Mesh mesh = test::MergeMeshes({test::BoxMesh({0, 0, 0}, {0.08, 0.08, 0.10}),
-                                 test::BoxMesh({0.055, 0, 0}, {0.03, 0.02, 0.06})});
-  ObjectSpec spec;
-  spec.name = "mug-like";
-  spec.keypoints.resize(3, 3);
-  spec.keypoints << 0.07, -0.04, -0.04, 0.0, -0.04, 0.04, 0.0, 0.05, -0.05;
-  spec.indicator_sets = {{0}};
-  spec.eps_oc = 0.01;
-  spec.delta_nd = 0.008;
+  const Mesh mesh = test::MugLikeMesh();
+  const ObjectSpec spec = test::MugLikeSpec();
   const ObjectModel mug(spec, mesh);
   const CertificateOptions options = CertificateOptions::FromObject(spec);
   const PointSet all = SampleSurface(mesh, 3000, 5);

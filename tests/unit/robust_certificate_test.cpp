@@ -147,15 +147,8 @@ TEST_CASE("oc with m = 0 is the paper's eq. 19 (one far point fails)") {
 
 TEST_CASE("nd_m fails when an indicator keypoint has only m supporting points") {
   // The mug-like object: body + handle; the handle keypoint alone is the set.
-  Mesh mesh = test::MergeMeshes({test::BoxMesh({0, 0, 0}, {0.08, 0.08, 0.10}),
-                                 test::BoxMesh({0.055, 0, 0}, {0.03, 0.02, 0.06})});
-  ObjectSpec spec;
-  spec.name = "mug-like";
-  spec.keypoints.resize(3, 3);
-  spec.keypoints << 0.07, -0.04, -0.04, 0.0, -0.04, 0.04, 0.0, 0.05, -0.05;
-  spec.indicator_sets = {{0}};
-  spec.eps_oc = 0.01;
-  spec.delta_nd = 0.008;
+  const Mesh mesh = test::MugLikeMesh();
+  const ObjectSpec spec = test::MugLikeSpec();
   ObjectModelOptions model_options;
   model_options.sample_size = 20000;
   const ObjectModel mug(spec, mesh, model_options);
