@@ -7,12 +7,25 @@
 #include <filesystem>
 #include <string>
 
+#include "c3po/base/error.hpp"
+
 namespace c3po::test {
 
 inline std::string SharedData() { return C3PO_SHARED_DATA; }
 inline std::string SourceDir() { return C3PO_SOURCE_DIR; }
 inline std::string Executable() { return C3PO_EXECUTABLE; }
 inline bool HaveSharedYcb() { return std::filesystem::exists(SharedData() + "/ycb"); }
+
+// The message of the InputError that f() throws ("" when it throws none).
+template <typename F>
+std::string InputErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
 
 // A fresh empty folder under the test binary dir, removed on destruction.
 // Unique per process: ctest runs the cases of one file as parallel processes.

@@ -12,6 +12,8 @@
 #include "c3po/base/error.hpp"
 #include "test_helpers.hpp"
 
+using c3po::test::InputErrorOf;
+
 namespace {
 
 std::vector<std::string> Listing(const std::string& folder) {
@@ -21,16 +23,6 @@ std::vector<std::string> Listing(const std::string& folder) {
   }
   std::sort(names.begin(), names.end());
   return names;
-}
-
-template <typename F>
-std::string InputErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const c3po::InputError& error) {
-    return error.what();
-  }
-  return "";
 }
 
 }  // namespace

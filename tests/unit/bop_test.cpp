@@ -25,6 +25,8 @@
 #include "c3po/io/rle.hpp"
 #include "test_helpers.hpp"
 
+using c3po::test::InputErrorOf;
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -110,16 +112,6 @@ Eigen::Matrix3d MatrixOf(const json& rows) {
 double PoseHausdorff(const c3po::ObjectModel& object, const c3po::Pose& a, const c3po::Pose& b) {
   return std::max(object.DistancesToPosedModel(a * object.sample(), b).maxCoeff(),
                   object.DistancesToPosedModel(b * object.sample(), a).maxCoeff());
-}
-
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const c3po::InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 // A shared split of two scenes (built once per process).
@@ -215,7 +207,7 @@ TEST_CASE("targets restrict images, detections give RLE masks identical to the f
   detections[1]["segmentation"]["counts"] = "ab\x7f";
   c3po::WriteFileAtomically(dir / "bad.json", detections.dump());
   options.detections_path = dir / "bad.json";
-  CHECK(ErrorOf([&] { c3po::ListBopInstances(split.dir / "test", options); }).find(dir / "bad.json" + ": detection 1: segmentation: malformed RLE") == 0);
+  CHECK(InputErrorOf([&] { c3po::ListBopInstances(split.dir / "test", options); }).find(dir / "bad.json" + ": detection 1: segmentation: malformed RLE") == 0);
 }
 
 TEST_CASE("bad BOP folders: masks disagreeing with scene_gt.json, non-numbered scenes, missing camera entries, non-rotations") {
@@ -224,15 +216,15 @@ TEST_CASE("bad BOP folders: masks disagreeing with scene_gt.json, non-numbered s
   c3po::BopOptions options;
   options.obj_id = 1;
   fs::remove(dir / "split/000001/mask_visib/000002_000001.png");
-  CHECK(ErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }) ==
+  CHECK(InputErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }) ==
         dir / "split/000001/scene_gt.json" +
             ": image 2 lists 2 instances but mask_visib/ holds 1 masks 000002_*.png (expected gt_id 0..1)");
   fs::copy_file(dir / "split/000001/mask_visib/000002_000000.png", dir / "split/000001/mask_visib/000002_000001.png");
   fs::copy_file(dir / "split/000001/mask_visib/000002_000000.png", dir / "split/000001/mask_visib/000003_000000.png");
-  CHECK(ErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }).find("no entry for image 3 but mask_visib/ holds its masks") != std::string::npos);
+  CHECK(InputErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }).find("no entry for image 3 but mask_visib/ holds its masks") != std::string::npos);
   fs::remove(dir / "split/000001/mask_visib/000003_000000.png");
   fs::create_directories(dir / "split/extras");
-  CHECK(ErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }) ==
+  CHECK(InputErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }) ==
         dir / "split/extras" + ": non-numbered scene folder in a BOP split (expected NNNNNN/)");
   fs::remove(dir / "split/extras");
   CHECK(c3po::ListBopInstances(dir / "split", options).instances.size() == 2);
@@ -246,14 +238,14 @@ TEST_CASE("bad BOP folders: masks disagreeing with scene_gt.json, non-numbered s
   json cameras = json::parse(gt);
   cameras.erase("2");
   c3po::WriteFileAtomically(dir / "split/000001/scene_camera.json", cameras.dump());
-  CHECK(ErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }) == dir / "split/000001/scene_camera.json: no entry for image 2");
+  CHECK(InputErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }) == dir / "split/000001/scene_camera.json: no entry for image 2");
 
-  CHECK(ErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"obj_id": 1, "cam_R_m2c": [1,0,0,0,1,0,0,0,1.01], "cam_t_m2c": [0,0,1]}]})", "g.json"); })
+  CHECK(InputErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"obj_id": 1, "cam_R_m2c": [1,0,0,0,1,0,0,0,1.01], "cam_t_m2c": [0,0,1]}]})", "g.json"); })
             .find("g.json: 1[0]: cam_R_m2c: not orthonormal (max |R^T R - I| = 0.0201") == 0);
-  CHECK(ErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"obj_id": 1, "cam_R_m2c": [1,0,0,0,1,0,0,0,-1], "cam_t_m2c": [0,0,1]}]})", "g.json"); }) ==
+  CHECK(InputErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"obj_id": 1, "cam_R_m2c": [1,0,0,0,1,0,0,0,-1], "cam_t_m2c": [0,0,1]}]})", "g.json"); }) ==
         "g.json: 1[0]: cam_R_m2c: determinant is -1 (a reflection, not a rotation)");
-  CHECK(ErrorOf([] { c3po::ParseSceneGt(R"({"x": []})", "g.json"); }) == "g.json: key 'x' is not an image id");
-  CHECK(ErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"cam_R_m2c": [], "cam_t_m2c": []}]})", "g.json"); }) == "g.json: 1[0]: obj_id: missing");
+  CHECK(InputErrorOf([] { c3po::ParseSceneGt(R"({"x": []})", "g.json"); }) == "g.json: key 'x' is not an image id");
+  CHECK(InputErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"cam_R_m2c": [], "cam_t_m2c": []}]})", "g.json"); }) == "g.json: 1[0]: obj_id: missing");
 }
 
 TEST_CASE("models_info.json: diameters and symmetries") {
@@ -263,7 +255,7 @@ TEST_CASE("models_info.json: diameters and symmetries") {
   CHECK(info.at(1).diameter_mm == 102.1);
   CHECK(info.at(1).discrete_symmetries == 1);
   CHECK(info.at(13).continuous_symmetry);
-  CHECK(ErrorOf([] { c3po::ParseModelsInfo(R"({"1": {"diameter": -1}})", "mi.json"); }) == "mi.json: 1: diameter: must be positive");
+  CHECK(InputErrorOf([] { c3po::ParseModelsInfo(R"({"1": {"diameter": -1}})", "mi.json"); }) == "mi.json: 1: diameter: must be positive");
 }
 
 TEST_CASE("certify --bop: ids in every line, certified poses correct, BOP CSV read back independently") {

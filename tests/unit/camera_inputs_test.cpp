@@ -19,22 +19,14 @@
 #include "c3po/io/support_plane.hpp"
 #include "test_helpers.hpp"
 
+using c3po::test::InputErrorOf;
+
 namespace {
 
 using c3po::DepthImage;
 using c3po::Mask;
 
 const c3po::PinholeCamera kCamera{600.0, 610.0, 159.5, 121.0};
-
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const c3po::InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 Mask FullMask(int w, int h) { return Mask{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h, 1)}; }
 
@@ -158,7 +150,7 @@ TEST_CASE("masks: non-zero and label images, sizes must match the depth") {
   CHECK(c3po::MaskFromImage(label, 2).Count() == 4);
   CHECK(c3po::MaskFromImage(label, 9).Count() == 0);
   DepthImage depth{5, 3, std::vector<float>(15, 1.0f)};
-  const std::string error = ErrorOf([&] {
+  const std::string error = InputErrorOf([&] {
     c3po::ExtractSegment(depth, c3po::MaskFromImage(label), kCamera, NoPreprocessing(), "m.png");
   });
   CHECK(error.find("m.png: depth is 5 x 3 but the mask is 4 x 3") == 0);
@@ -350,7 +342,7 @@ TEST_CASE("support plane: the table under a ball is found, the mask's bleed onto
   const TableScene wide = MakeTableScene(w, h, 40);
   const c3po::SegmentCloud mostly_table = c3po::ExtractSegment(wide.depth, wide.mask, kCamera, options, "wide.png");
   REQUIRE(mostly_table.removed_by_plane > (wide.mask.Count() - mostly_table.no_depth) / 2);
-  const std::string error = ErrorOf([&] { c3po::RequireUsableSegment(mostly_table, "wide.png"); });
+  const std::string error = InputErrorOf([&] { c3po::RequireUsableSegment(mostly_table, "wide.png"); });
   CHECK(error.find("wide.png: the mask is mostly the support plane") == 0);
   CHECK_NOTHROW(c3po::RequireUsableSegment(
       c3po::ExtractSegment(wide.depth, wide.mask, kCamera, NoPreprocessing(), "wide.png"), "wide.png"));
@@ -435,7 +427,7 @@ TEST_CASE("unusable segments: no pixels, no depth, too few points left") {
   DepthImage depth{6, 6, std::vector<float>(36, 0.0f)};
   Mask empty{6, 6, std::vector<std::uint8_t>(36, 0)};
   auto message = [&](const Mask& mask, const DepthImage& d) {
-    return ErrorOf([&] { c3po::RequireUsableSegment(c3po::ExtractSegment(d, mask, kCamera, c3po::SegmentOptions{}, "m.png"), "m.png"); });
+    return InputErrorOf([&] { c3po::RequireUsableSegment(c3po::ExtractSegment(d, mask, kCamera, c3po::SegmentOptions{}, "m.png"), "m.png"); });
   };
   CHECK(message(empty, depth) == "m.png: mask has no pixels");
   CHECK(message(FullMask(6, 6), depth) == "m.png: no valid depth under the mask (36 pixels)");
@@ -479,13 +471,13 @@ TEST_CASE("COCO RLE: compressed == uncompressed == brute-force pixels (column-ma
 }
 
 TEST_CASE("malformed RLE is an InputError naming the file") {
-  CHECK(ErrorOf([] { c3po::ParseRleString("ab\x01", "d.json"); }).find("d.json: malformed RLE: character") == 0);
-  CHECK(ErrorOf([] { c3po::ParseRleString("1P", "d.json"); }).find("d.json: malformed RLE: string ends inside a run") == 0);
-  CHECK(ErrorOf([] { c3po::ParseRleString("oooooooooooooooo0", "d.json"); }).find("d.json: malformed RLE: run too long") == 0);
-  CHECK(ErrorOf([] { c3po::DecodeRle(4, 4, {3, 4}, "d.json"); }).find("d.json: malformed RLE: runs cover 7 pixels") == 0);
-  CHECK(ErrorOf([] { c3po::DecodeRle(4, 4, {3, 40}, "d.json"); }).find("d.json: malformed RLE: runs cover more") == 0);
-  CHECK(ErrorOf([] { c3po::DecodeRle(4, 4, {3, -1, 14}, "d.json"); }).find("d.json: malformed RLE: negative run") == 0);
-  CHECK(ErrorOf([] { c3po::DecodeRle(0, 4, {}, "d.json"); }).find("d.json: malformed RLE: bad size") == 0);
+  CHECK(InputErrorOf([] { c3po::ParseRleString("ab\x01", "d.json"); }).find("d.json: malformed RLE: character") == 0);
+  CHECK(InputErrorOf([] { c3po::ParseRleString("1P", "d.json"); }).find("d.json: malformed RLE: string ends inside a run") == 0);
+  CHECK(InputErrorOf([] { c3po::ParseRleString("oooooooooooooooo0", "d.json"); }).find("d.json: malformed RLE: run too long") == 0);
+  CHECK(InputErrorOf([] { c3po::DecodeRle(4, 4, {3, 4}, "d.json"); }).find("d.json: malformed RLE: runs cover 7 pixels") == 0);
+  CHECK(InputErrorOf([] { c3po::DecodeRle(4, 4, {3, 40}, "d.json"); }).find("d.json: malformed RLE: runs cover more") == 0);
+  CHECK(InputErrorOf([] { c3po::DecodeRle(4, 4, {3, -1, 14}, "d.json"); }).find("d.json: malformed RLE: negative run") == 0);
+  CHECK(InputErrorOf([] { c3po::DecodeRle(0, 4, {}, "d.json"); }).find("d.json: malformed RLE: bad size") == 0);
 }
 
 TEST_CASE("camera JSON: cam_K, BOP camera.json, one-entry scene_camera.json, --intrinsics, errors") {
@@ -503,20 +495,20 @@ TEST_CASE("camera JSON: cam_K, BOP camera.json, one-entry scene_camera.json, --i
   const auto intrinsics = c3po::CameraFromIntrinsics("500,501,300,200", 0.1);
   CHECK((intrinsics.K.fx == 500 && intrinsics.K.cy == 200 && intrinsics.depth_scale == 0.1));
 
-  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"depth_scale": 1})", "c.json"); }) == "c.json: cam_K: missing (nor fx, fy, cx, cy)");
-  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1]})", "c.json"); }) ==
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson(R"({"depth_scale": 1})", "c.json"); }) == "c.json: cam_K: missing (nor fx, fy, cx, cy)");
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1]})", "c.json"); }) ==
         "c.json: depth_scale: missing (give --depth-scale S)");
-  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 0})", "c.json"); })
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 0})", "c.json"); })
             .find("c.json: depth_scale must be a positive number") == 0);
-  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": -1})", "c.json"); })
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": -1})", "c.json"); })
             .find("c.json: depth_scale must be a positive number") == 0);
-  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4], "depth_scale": 1})", "c.json"); }) ==
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4], "depth_scale": 1})", "c.json"); }) ==
         "c.json: cam_K: expected 9 numbers (row-major 3x3)");
-  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0.5, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 1})", "c.json"); })
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [1, 0.5, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 1})", "c.json"); })
             .find("c.json: cam_K: expected [fx, 0, cx, 0, fy, cy, 0, 0, 1]") == 0);
-  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [-1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 1})", "c.json"); })
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson(R"({"cam_K": [-1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 1})", "c.json"); })
             .find("c.json: focal lengths must be positive") == 0);
-  CHECK(ErrorOf([] { c3po::ParseCameraJson(R"({"1": {}, "2": {}})", "s.json"); }).find("s.json: a scene_camera.json of 2 images") == 0);
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson(R"({"1": {}, "2": {}})", "s.json"); }).find("s.json: a scene_camera.json of 2 images") == 0);
   // --im-id picks one entry of a scene_camera.json of several images.
   const std::string two = R"({"3": {"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 0.5},
                               "4": {"cam_K": [5, 0, 6, 0, 7, 8, 0, 0, 1], "depth_scale": 0.25}})";
@@ -524,14 +516,14 @@ TEST_CASE("camera JSON: cam_K, BOP camera.json, one-entry scene_camera.json, --i
   CHECK((four.K.fx == 5 && four.K.fy == 7 && four.K.cx == 6 && four.K.cy == 8 && four.depth_scale == 0.25));
   const auto three = c3po::ParseCameraJson(two, "s.json", 2.0, 3);
   CHECK((three.K.fx == 1 && three.depth_scale == 2.0));
-  CHECK(ErrorOf([&] { c3po::ParseCameraJson(two, "s.json"); }).find("s.json: a scene_camera.json of 2 images; give --im-id") == 0);
-  CHECK(ErrorOf([&] { c3po::ParseCameraJson(two, "s.json", std::nullopt, 5); }).find("s.json: --im-id 5: no such image") == 0);
-  CHECK(ErrorOf([&] { c3po::ParseCameraJson(two, "s.json", std::nullopt, -3); }).find("s.json: --im-id -3: no such image") == 0);
+  CHECK(InputErrorOf([&] { c3po::ParseCameraJson(two, "s.json"); }).find("s.json: a scene_camera.json of 2 images; give --im-id") == 0);
+  CHECK(InputErrorOf([&] { c3po::ParseCameraJson(two, "s.json", std::nullopt, 5); }).find("s.json: --im-id 5: no such image") == 0);
+  CHECK(InputErrorOf([&] { c3po::ParseCameraJson(two, "s.json", std::nullopt, -3); }).find("s.json: --im-id -3: no such image") == 0);
   // A single camera serves every image: --im-id has nothing to pick.
   CHECK(c3po::ParseCameraJson(R"({"cam_K": [1, 0, 2, 0, 3, 4, 0, 0, 1], "depth_scale": 0.1})", "c.json", std::nullopt, 9).K.fx == 1);
-  CHECK(ErrorOf([] { c3po::ParseCameraJson("{", "c.json"); }).find("c.json: not valid JSON") == 0);
-  CHECK(ErrorOf([] { c3po::CameraFromIntrinsics("1,2,3", 1.0); }) == "--intrinsics: expected 4 numbers fx,fy,cx,cy");
-  CHECK(ErrorOf([] { c3po::CameraFromIntrinsics("1,2,3,4", 0.0); }).find("--intrinsics/--depth-scale: depth_scale must be") == 0);
+  CHECK(InputErrorOf([] { c3po::ParseCameraJson("{", "c.json"); }).find("c.json: not valid JSON") == 0);
+  CHECK(InputErrorOf([] { c3po::CameraFromIntrinsics("1,2,3", 1.0); }) == "--intrinsics: expected 4 numbers fx,fy,cx,cy");
+  CHECK(InputErrorOf([] { c3po::CameraFromIntrinsics("1,2,3,4", 0.0); }).find("--intrinsics/--depth-scale: depth_scale must be") == 0);
 }
 
 TEST_CASE(".npy depth: C and Fortran order, float64, strict header and size") {
@@ -554,19 +546,19 @@ TEST_CASE(".npy depth: C and Fortran order, float64, strict header and size") {
     }
   }
   CHECK(c3po::ParseNpyDepth(f64, "f.npy").z == depth.z);
-  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(npy.substr(0, npy.size() - 4), "d.npy"); }).find("d.npy: .npy data holds") == 0);
-  CHECK(ErrorOf([] { c3po::ParseNpyDepth("PK\x03\x04", "d.npy"); }) == "d.npy: not a .npy file (bad magic)");
+  CHECK(InputErrorOf([&] { c3po::ParseNpyDepth(npy.substr(0, npy.size() - 4), "d.npy"); }).find("d.npy: .npy data holds") == 0);
+  CHECK(InputErrorOf([] { c3po::ParseNpyDepth("PK\x03\x04", "d.npy"); }) == "d.npy: not a .npy file (bad magic)");
   std::string i16 = npy;
   i16.replace(i16.find("<f4"), 3, "<i2");
-  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(i16, "d.npy"); }).find("d.npy: .npy dtype '<i2' is not float32") == 0);
+  CHECK(InputErrorOf([&] { c3po::ParseNpyDepth(i16, "d.npy"); }).find("d.npy: .npy dtype '<i2' is not float32") == 0);
   std::string three = npy;
   three.replace(three.find("(2, 3)"), 6, "(2,3,1)");
-  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(three, "d.npy"); }).find("d.npy: .npy depth must have shape (H, W)") == 0);
+  CHECK(InputErrorOf([&] { c3po::ParseNpyDepth(three, "d.npy"); }).find("d.npy: .npy depth must have shape (H, W)") == 0);
   std::string no_tuple = npy;   // found by fuzz_npy: an empty shape value
   no_tuple.replace(no_tuple.find("(2, 3)"), 6, " ,(23)");
-  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(no_tuple, "d.npy"); }) == "d.npy: .npy header: shape must be a tuple (H, W)");
+  CHECK(InputErrorOf([&] { c3po::ParseNpyDepth(no_tuple, "d.npy"); }) == "d.npy: .npy header: shape must be a tuple (H, W)");
   DepthImage negative{1, 1, {-1.0f}};
-  CHECK(ErrorOf([&] { c3po::ParseNpyDepth(c3po::EncodeNpyDepth(negative), "d.npy"); }) == "d.npy: negative or infinite depth in .npy");
+  CHECK(InputErrorOf([&] { c3po::ParseNpyDepth(c3po::EncodeNpyDepth(negative), "d.npy"); }) == "d.npy: negative or infinite depth in .npy");
 }
 
 TEST_CASE("depth PNG: value x depth_scale = mm, converted to metres, 8-bit depth refused") {
@@ -578,7 +570,7 @@ TEST_CASE("depth PNG: value x depth_scale = mm, converted to metres, 8-bit depth
   CHECK(c3po::ReadDepth(dir / "d.png", 0.1).z == std::vector<float>{0.1f, static_cast<float>(6.5535)});
   c3po::Image eight(2, 1, 8);
   c3po::WritePng(dir / "m.png", eight);
-  CHECK(ErrorOf([&] { c3po::ReadDepth(dir / "m.png", 1.0); }).find("8-bit PNG given as depth") != std::string::npos);
+  CHECK(InputErrorOf([&] { c3po::ReadDepth(dir / "m.png", 1.0); }).find("8-bit PNG given as depth") != std::string::npos);
 }
 
 TEST_CASE("--shard K/N: disjoint contiguous parts whose concatenation is the whole, groups kept together") {
@@ -596,12 +588,12 @@ TEST_CASE("--shard K/N: disjoint contiguous parts whose concatenation is the who
   // A group never splits: with 2 parts of 6 groups the cut is after group 3 (key 7).
   CHECK(c3po::ShardJobs(keys, {1, 2}) == std::vector<std::size_t>{0, 1, 2, 3, 4, 5});
   CHECK(c3po::ParseShard("3/8").index == 3);
-  CHECK(ErrorOf([] { c3po::ParseShard("0/4"); }) == "--shard: '0/4': need 1 <= K <= N");
-  CHECK(ErrorOf([] { c3po::ParseShard("5/4"); }) == "--shard: '5/4': need 1 <= K <= N");
-  CHECK(ErrorOf([] { c3po::ParseShard("2"); }) == "--shard: '2' is not K/N (e.g. 3/8)");
-  CHECK(ErrorOf([] { c3po::MergeShardOutputs({{"a.csv", "scene_id,im_id,obj_id,score,R,t,time\n1,2,3,4,5,6,7\n"}, {"b.csv", "x\n"}}, true); }) ==
+  CHECK(InputErrorOf([] { c3po::ParseShard("0/4"); }) == "--shard: '0/4': need 1 <= K <= N");
+  CHECK(InputErrorOf([] { c3po::ParseShard("5/4"); }) == "--shard: '5/4': need 1 <= K <= N");
+  CHECK(InputErrorOf([] { c3po::ParseShard("2"); }) == "--shard: '2' is not K/N (e.g. 3/8)");
+  CHECK(InputErrorOf([] { c3po::MergeShardOutputs({{"a.csv", "scene_id,im_id,obj_id,score,R,t,time\n1,2,3,4,5,6,7\n"}, {"b.csv", "x\n"}}, true); }) ==
         "b.csv: line 1: not a BOP results CSV header");
   CHECK(c3po::MergeShardOutputs({{"a.csv", "scene_id,im_id,obj_id,score,R,t,time\n1\n"}, {"b.csv", "scene_id,im_id,obj_id,score,R,t,time\n2\n"}}, true) ==
         "scene_id,im_id,obj_id,score,R,t,time\n1\n2\n");
-  CHECK(ErrorOf([] { c3po::MergeShardOutputs({{"a.jsonl", "{}\nnope\n"}}, false); }) == "a.jsonl: line 2: not a JSON object");
+  CHECK(InputErrorOf([] { c3po::MergeShardOutputs({{"a.jsonl", "{}\nnope\n"}}, false); }) == "a.jsonl: line 2: not a JSON object");
 }

@@ -15,6 +15,8 @@
 #include "c3po/io/cloud_io.hpp"
 #include "test_helpers.hpp"
 
+using c3po::test::InputErrorOf;
+
 namespace {
 
 using c3po::CloudFormat;
@@ -40,16 +42,6 @@ PointSet AsFloat32(const PointSet& points) {
 }
 
 // The message of the InputError thrown by `parse`, or "" if none was thrown.
-template <typename F>
-std::string InputErrorOf(F&& parse) {
-  try {
-    parse();
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "";
-}
-
 std::string ParseError(const std::string& bytes, CloudFormat format, const std::string& name) {
   return InputErrorOf([&] { c3po::ParseCloud(bytes, format, name); });
 }

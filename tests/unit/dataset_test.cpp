@@ -16,19 +16,11 @@
 #include "c3po/io/dataset_writer.hpp"
 #include "test_helpers.hpp"
 
+using c3po::test::InputErrorOf;
+
 namespace fs = std::filesystem;
 
 namespace {
-
-template <typename F>
-std::string InputErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const c3po::InputError& error) {
-    return error.what();
-  }
-  return "";
-}
 
 c3po::PointSet RandomPoints(c3po::Rng& rng, int n) {
   c3po::PointSet points(3, n);
