@@ -38,17 +38,19 @@ run_all() {   # run_all THREADS: every output under t$THREADS/
   local t=$1 out="t$1"
   mkdir -p "$out"
   export C3PO_THREADS=$t
-  "$C3PO" synth "$MUG" -o "$out/depth" --kind depth --count 16 --points 400 --noise 1mm --seed 4 > /dev/null 2>&1 ||
-    fail "synth depth ($t threads)"
+  "$C3PO" synth "$MUG" -o "$out/depth" --kind depth --count 16 --points 400 --noise 1mm --seed 4 \
+    > /dev/null 2>&1 || fail "synth depth ($t threads)"
   "$C3PO" synth "$DRILL" -o "$out/bop" --format bop --count 4 --obj-id 1 --distractors 1 --distractor "$BOX:2" \
-    --artefacts realistic --intrinsics 400,400,159.5,119.5,320,240 --seed 4 > /dev/null 2>&1 || fail "synth bop ($t threads)"
+    --artefacts realistic --intrinsics 400,400,159.5,119.5,320,240 --seed 4 > /dev/null 2>&1 ||
+    fail "synth bop ($t threads)"
   "$C3PO" certify "$MUG" --data "$out/depth" --detector svd -o "$out/certify.jsonl" > /dev/null 2>&1
   [ $? -le 1 ] || fail "certify --data ($t threads)"
   "$C3PO" certify "$DRILL" --bop "$out/bop" --obj-id 1 --detector svd -o "$out/certify_bop.jsonl" > /dev/null 2>&1
   [ $? -le 1 ] || fail "certify --bop ($t threads)"
   "$C3PO" eval "$MUG" --data "$out/depth" --detector svd --json "$out/eval.json" > /dev/null 2>&1 ||
     fail "eval ($t threads)"
-  "$C3PO" indicators "$BOX" --auto --views 12 --seed 2 > "$out/indicators.txt" 2>&1 || fail "indicators --auto ($t threads)"
+  "$C3PO" indicators "$BOX" --auto --views 12 --seed 2 > "$out/indicators.txt" 2>&1 ||
+    fail "indicators --auto ($t threads)"
   sed -i 's/[0-9.]* s\b//g' "$out/indicators.txt"
   if [ "${C3PO_WITH_POINTNET:-ON}" != OFF ]; then
     "$C3PO" train "$MUG" --data "$out/depth" -o "$out/mug.model" --epochs 4 --point-mlp 16 16 --head 16 --points 64 \
@@ -76,6 +78,7 @@ if [ "${C3PO_WITH_POINTNET:-ON}" != OFF ]; then
     fail "selftrain: the logs differ between 1 and 3 threads"
 fi
 certified=$(grep -c '"certified":true' t1/certify.jsonl)
-echo "certify --data: $(wc -l < t1/certify.jsonl) lines ($certified certified), --bop: $(wc -l < t1/certify_bop.jsonl) lines"
+echo "certify --data: $(wc -l < t1/certify.jsonl) lines ($certified certified)," \
+     "--bop: $(wc -l < t1/certify_bop.jsonl) lines"
 [ "$failures" -eq 0 ] && echo "ok: the same outputs with 1 and 3 threads"
 exit $((failures > 0))

@@ -79,8 +79,11 @@ def check_paths(doc, lineno, line, files, folders, cmake_text, report):
             report(doc, lineno, f"names `{span}`, which is not a file of the repository")
 
 
+CAMEL_CASE = re.compile(r"`([A-Z][A-Za-z0-9]*[a-z0-9][A-Z][A-Za-z0-9]*(?:::[A-Za-z_][A-Za-z0-9_]*)?)(?:\(\))?`")
+
+
 def check_names(doc, lineno, line, code_words, report):
-    for span in re.findall(r"`([A-Z][A-Za-z0-9]*[a-z0-9][A-Z][A-Za-z0-9]*(?:::[A-Za-z_][A-Za-z0-9_]*)?)(?:\(\))?`", line):
+    for span in CAMEL_CASE.findall(line):
         name = span.split("::")[-1]
         if name not in code_words:
             report(doc, lineno, f"names `{span}`, which no C++ or CMake source defines or uses")
@@ -158,7 +161,8 @@ def check_options(doc, lineno, line, commands, report):
             continue
         for option in re.findall(r"(?<![\w-])--[a-z0-9][a-z0-9-]*", rest):
             if option not in known:
-                report(doc, lineno, f"gives `c3po {' '.join(words)}` the option {option}, which its --help does not list")
+                report(doc, lineno,
+                       f"gives `c3po {' '.join(words)}` the option {option}, which its --help does not list")
 
 
 def check_named_options(doc, lineno, line, every_option, report):
