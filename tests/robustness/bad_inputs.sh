@@ -164,6 +164,18 @@ spec['keypoints'][0] = [0.5, 0.5, 0.0]
 json.dump(spec, open(sys.argv[2], 'w'))
 PY
 check model_other_object "2" - cube.model cube.model other.json -- "$C3PO" certify other.json --model cube.model sim/000000.ply
+# The corrector benchmark on clouds of another object (their label) or with another keypoint count.
+check bench_other_object "2" - sim/manifest.jsonl other.json sim -- "$C3PO" bench corrector other.json --data sim
+python3 - "$CUBE" fewer.json <<'PY'
+import json, sys
+spec = json.load(open(sys.argv[1]))
+spec['keypoints'] = spec['keypoints'][:-1]
+if 'keypoint_names' in spec:
+    spec['keypoint_names'] = spec['keypoint_names'][:-1]
+spec['indicator_sets'] = [s for s in spec.get('indicator_sets', []) if max(s) < len(spec['keypoints'])]
+json.dump(spec, open(sys.argv[2], 'w'))
+PY
+check bench_keypoint_count "2" - sim/manifest.jsonl fewer.json sim -- "$C3PO" bench corrector fewer.json --data sim
 head -c 1000 cube.model > truncated.model
 check model_truncated "2" - truncated.model truncated.model -- "$C3PO" certify "$CUBE" --model truncated.model sim/000000.ply
 : > empty.model

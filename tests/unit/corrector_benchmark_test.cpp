@@ -61,3 +61,37 @@ TEST_CASE("corrector benchmark: rows, times split, and reproducible cases") {
     CHECK(again.cost_before == doctest::Approx(one.cost_before).epsilon(1e-12));
   }
 }
+
+TEST_CASE("corrector benchmark: clouds of another object are refused, naming the manifest line") {
+  const ObjectModel object = test::AsymmetricObject();
+  const test::TempDir dir("corrector_benchmark_other");
+  SynthOptions synth;
+  synth.kind = CloudKind::kDepth;
+  synth.count = 2;
+  synth.points = 200;
+  synth.seed = 3;
+  WriteSynthDataset(object.mesh(), object.spec(), synth, dir / "depth");
+  Dataset dataset = ReadDataset(dir / "depth");
+  CorrectorBenchmarkOptions options;
+  options.sigmas = {0.1};
+  options.certificate = CertificateOptions::FromObject(object.spec());
+  const std::string line = dir / "depth/manifest.jsonl: line 2 (" + dataset.entries[1].cloud + ")";
+
+  // Another object's label on the second cloud.
+  dataset.entries[1].object = "drill";
+  const std::string other = test::InputErrorOf([&] { RunCorrectorBenchmark(object, dataset, options, {}); });
+  CHECK(other == line + ": a cloud of object 'drill', not '" + object.name() + "'");
+
+  // Unlabelled, but with one keypoint fewer than the object (before, the registration threw a bare
+  // "RegisterPoints: model and scene sizes differ").
+  dataset.entries[1].object.reset();
+  const PointSet all = *dataset.entries[1].keypoints;
+  dataset.entries[1].keypoints = PointSet(all.leftCols(all.cols() - 1));
+  const std::string fewer = test::InputErrorOf([&] { RunCorrectorBenchmark(object, dataset, options, {}); });
+  CHECK(fewer == line + ": " + std::to_string(all.cols() - 1) + " keypoints, the object '" + object.name() +
+                     "' has " + std::to_string(all.cols()));
+
+  // The same dataset, as written, runs.
+  const Dataset intact = ReadDataset(dir / "depth");
+  CHECK(RunCorrectorBenchmark(object, intact, options, {}).size() == 1 + options.solvers.size());   // + registration
+}

@@ -106,12 +106,14 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
   return out;
 }
 
-CorrectorBenchmarkRow Summarise(double sigma, const std::string& method, const std::vector<Sample>& samples,
-                                double correct_hausdorff) {
-  CorrectorBenchmarkRow row;
-  row.sigma = sigma;
-  row.method = method;
-  row.clouds = static_cast<int>(samples.size());
+double Mean(const std::vector<double>& v) {
+  double sum = 0;
+  for (double x : v) sum += x;
+  return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+}
+
+// Pose errors, % oc, iterations and times of the samples.
+void SummariseAccuracyAndSpeed(const std::vector<Sample>& samples, CorrectorBenchmarkRow* row) {
   std::vector<double> rot, trans, adds, ms, corrector_ms, corrector_cpu_ms, certify_ms;
   double oc = 0, iterations = 0;
   for (const auto& s : samples) {
@@ -125,24 +127,23 @@ CorrectorBenchmarkRow Summarise(double sigma, const std::string& method, const s
     oc += s.oc;
     iterations += s.iterations;
   }
-  auto mean = [](const std::vector<double>& v) {
-    double sum = 0;
-    for (double x : v) sum += x;
-    return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
-  };
-  row.median_rotation_deg = Median(rot);
-  row.mean_rotation_deg = mean(rot);
-  row.median_translation_over_d = Median(trans);
-  row.mean_translation_over_d = mean(trans);
-  row.median_adds_over_d = Median(adds);
-  row.percent_oc = samples.empty() ? 0.0 : 100.0 * oc / static_cast<double>(samples.size());
-  row.median_ms = Median(ms);
-  row.mean_ms = mean(ms);
-  row.median_corrector_ms = Median(corrector_ms);
-  row.mean_corrector_ms = mean(corrector_ms);
-  row.median_corrector_cpu_ms = Median(corrector_cpu_ms);
-  row.median_certify_ms = Median(certify_ms);
-  row.mean_iterations = samples.empty() ? 0.0 : iterations / static_cast<double>(samples.size());
+  row->median_rotation_deg = Median(rot);
+  row->mean_rotation_deg = Mean(rot);
+  row->median_translation_over_d = Median(trans);
+  row->mean_translation_over_d = Mean(trans);
+  row->median_adds_over_d = Median(adds);
+  row->percent_oc = samples.empty() ? 0.0 : 100.0 * oc / static_cast<double>(samples.size());
+  row->median_ms = Median(ms);
+  row->mean_ms = Mean(ms);
+  row->median_corrector_ms = Median(corrector_ms);
+  row->mean_corrector_ms = Mean(corrector_ms);
+  row->median_corrector_cpu_ms = Median(corrector_cpu_ms);
+  row->median_certify_ms = Median(certify_ms);
+  row->mean_iterations = samples.empty() ? 0.0 : iterations / static_cast<double>(samples.size());
+}
+
+// Certified, correct (Hausdorff <= correct_hausdorff) and false certificates; the local test's evidence.
+void SummariseCertificates(const std::vector<Sample>& samples, double correct_hausdorff, CorrectorBenchmarkRow* row) {
   int certified = 0, correct = 0, correct_certified = 0, nd_local = 0;
   std::vector<double> hausdorff, correct_eigenvalues;
   for (const auto& s : samples) {
@@ -151,22 +152,47 @@ CorrectorBenchmarkRow Summarise(double sigma, const std::string& method, const s
     correct += is_correct;
     correct_certified += is_correct && s.certified;
     nd_local += s.nd_local;
-    if (s.certified && !is_correct) ++row.false_certificates;
-    if (s.certified) row.max_certified_hausdorff = std::max(row.max_certified_hausdorff, s.hausdorff);
+    if (s.certified && !is_correct) ++row->false_certificates;
+    if (s.certified) row->max_certified_hausdorff = std::max(row->max_certified_hausdorff, s.hausdorff);
     hausdorff.push_back(s.hausdorff);
     if (is_correct) correct_eigenvalues.push_back(s.nd_eigenvalue);
   }
   const double count = std::max<double>(1.0, static_cast<double>(samples.size()));
-  row.percent_certified = 100.0 * certified / count;
-  row.percent_correct = 100.0 * correct / count;
-  row.percent_correct_certified = correct > 0 ? 100.0 * correct_certified / correct : 0.0;
-  row.percent_nd_local = 100.0 * nd_local / count;
-  row.median_hausdorff = Median(hausdorff);
+  row->percent_certified = 100.0 * certified / count;
+  row->percent_correct = 100.0 * correct / count;
+  row->percent_correct_certified = correct > 0 ? 100.0 * correct_certified / correct : 0.0;
+  row->percent_nd_local = 100.0 * nd_local / count;
+  row->median_hausdorff = Median(hausdorff);
   if (!correct_eigenvalues.empty()) {
     std::sort(correct_eigenvalues.begin(), correct_eigenvalues.end());
-    row.q05_nd_eigenvalue_correct = correct_eigenvalues[correct_eigenvalues.size() / 20];
+    row->q05_nd_eigenvalue_correct = correct_eigenvalues[correct_eigenvalues.size() / 20];
   }
+}
+
+CorrectorBenchmarkRow Summarise(double sigma, const std::string& method, const std::vector<Sample>& samples,
+                                double correct_hausdorff) {
+  CorrectorBenchmarkRow row;
+  row.sigma = sigma;
+  row.method = method;
+  row.clouds = static_cast<int>(samples.size());
+  SummariseAccuracyAndSpeed(samples, &row);
+  SummariseCertificates(samples, correct_hausdorff, &row);
   return row;
+}
+
+// The first `count` clouds show the object (their label, if any, is its name) with its number of keypoints.
+void CheckBenchmarkClouds(const ObjectModel& object, const Dataset& dataset, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const DatasetEntry& entry = dataset.entries[i];
+    const std::string line = dataset.dir + "/manifest.jsonl: line " + std::to_string(i + 1) + " (" + entry.cloud + ")";
+    if (!dataset.Shows(i, object.name())) {
+      throw InputError(line, "a cloud of object '" + *entry.object + "', not '" + object.name() + "'");
+    }
+    if (entry.keypoints->cols() != object.num_keypoints()) {
+      throw InputError(line, std::to_string(entry.keypoints->cols()) + " keypoints, the object '" + object.name() +
+                                 "' has " + std::to_string(object.num_keypoints()));
+    }
+  }
 }
 
 }  // namespace
@@ -180,6 +206,7 @@ std::vector<CorrectorBenchmarkRow> RunCorrectorBenchmark(const ObjectModel& obje
   if (!dataset.HasGroundTruth()) throw InputError(dataset.dir, "the corrector benchmark needs ground-truth poses and keypoints");
   std::size_t count = dataset.entries.size();
   if (options.max_clouds > 0) count = std::min<std::size_t>(count, options.max_clouds);
+  CheckBenchmarkClouds(object, dataset, count);
   std::vector<PointSet> clouds(count);
   ParallelFor(0, static_cast<int>(count), [&](int i) {
     clouds[i] = dataset.LoadCloud(i);
