@@ -55,17 +55,22 @@ const std::vector<CommandEntry>& Commands() {
   return commands;
 }
 
+// The subcommands parsed below `app`, each after a space: " bench corrector" below the root.
+std::string ParsedSubcommands(const CLI::App& app) {
+  std::string names;
+  for (const CLI::App* sub = &app;;) {
+    const std::vector<CLI::App*> parsed = sub->get_subcommands();
+    if (parsed.empty()) return names;
+    sub = parsed.front();
+    names += " " + sub->get_name();
+  }
+}
+
 // A command-line error as one line, named like the run-time errors ("c3po certify: ..."); where the
 // command line itself was wrong (not a value a check refused, e.g. an unwritable --report path),
 // also where to look. Scripts read the first line of stderr.
 std::string OneLineParseError(const CLI::App* app, const CLI::Error& error) {
-  std::string command = "c3po";
-  for (const CLI::App* sub = app; sub != nullptr;) {
-    const std::vector<CLI::App*> parsed = sub->get_subcommands();
-    if (parsed.empty()) break;
-    sub = parsed.front();
-    command += " " + sub->get_name();
-  }
+  const std::string command = "c3po" + ParsedSubcommands(*app);
   const bool value_refused = dynamic_cast<const CLI::ValidationError*>(&error) != nullptr;
   return command + ": " + error.what() + (value_refused ? "" : " (" + command + " --help lists the options)") + "\n";
 }
@@ -118,7 +123,7 @@ int main(int argc, char** argv) {
   c3po::cli::InstallInterruptHandlers();
   for (auto& [command, run] : runners) {
     if (!command->parsed()) continue;
-    const std::string prefix = std::string("c3po ") + command->get_name() + ": ";
+    const std::string prefix = "c3po " + command->get_name() + ParsedSubcommands(*command) + ": ";
     try {
       return run();
     } catch (const c3po::InputError& e) {
