@@ -42,7 +42,7 @@ def repo_files(root):
     return files
 
 
-def first_folders(root, files):
+def first_folders(files):
     """Folder names a checked path may start with."""
     top = {f.split("/")[0] for f in files if "/" in f}
     layers = {f.split("/")[1] for f in files if f.startswith(("libc3po/", "plugins/")) and f.count("/") >= 2}
@@ -220,16 +220,17 @@ def main(argv):
     exe, root = argv[1], os.path.abspath(argv[2])
     docs = argv[3:] or default_docs(root)
     files = repo_files(root)
-    folders = first_folders(root, files)
-    sources = [f for f in files if f.endswith((".hpp", ".cpp", ".h", ".cmake", ".in")) or f.endswith("CMakeLists.txt")]
-    code_text = "\n".join(open(os.path.join(root, f), errors="replace").read() for f in sources)
-    cmake_text = "\n".join(open(os.path.join(root, f), errors="replace").read()
-                           for f in sources if f.endswith((".cmake", "CMakeLists.txt")))
-    code_words = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", code_text))
-    scripts = [f for f in files if f.endswith((".sh", ".py", ".js"))]
-    script_text = "\n".join(open(os.path.join(root, f), errors="replace").read() for f in scripts)
+    folders = first_folders(files)
+    texts = {f: open(os.path.join(root, f), errors="replace").read() for f in files
+             if f.endswith((".hpp", ".cpp", ".h", ".cmake", ".in", "CMakeLists.txt", ".sh", ".py", ".js"))}
+
+    def words(names):
+        return set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", "\n".join(texts[f] for f in names)))
+
+    code_words = words(f for f in texts if not f.endswith((".sh", ".py", ".js")))
+    cmake_text = "\n".join(text for f, text in texts.items() if f.endswith((".cmake", "CMakeLists.txt")))
     stems = {os.path.splitext(f.split("/")[-1])[0] for f in files}
-    source_words = code_words | set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", script_text)) | stems
+    source_words = code_words | words(f for f in texts if f.endswith((".sh", ".py", ".js"))) | stems
     commands = Commands(exe)
     every_option = commands.every_option()
     problems = []
