@@ -87,7 +87,8 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                    "A single motion the local test finds weak fails nd (by default the pose is displaced along it "
                    "and refitted: no second fit = constrained)");
   command.add_option("--global-steps", flags->global_steps,
-                     "Rival starts: rotations by k*360/N deg about each principal axis (N even, default 4)");
+                     "Rival starts: rotations by k*360/N deg about each principal axis (N even, default 4), "
+                     "and half-turns about the 10 diagonals of the principal frame");
   command.add_flag("--no-free-space", flags->no_free_space,
                    "Depth-image inputs: no free-space test (on by default)");
   command.add_option("--free-space-fraction", flags->free_space_fraction,

@@ -45,8 +45,20 @@ PrincipalFrame ModelPrincipalFrame(const ObjectModel& object) {
   return frame;
 }
 
+namespace {
+
+// Axis `axis` of the rival search: a principal axis (0-2) or a diagonal of
+// the principal frame (3-12, ReestimateAxes), unit.
+Eigen::Vector3d SearchAxis(const PrincipalFrame& frame, int axis) {
+  if (axis < 0 || axis > 12) throw std::invalid_argument("rival search axis must be in [0, 12]");
+  if (axis < 3) return frame.axes.col(axis).normalized();
+  return ReestimateAxes(frame).col(axis);
+}
+
+}  // namespace
+
 Pose AxisRotation(const PrincipalFrame& frame, int axis, double angle) {
-  const Eigen::Vector3d u = frame.axes.col(axis).normalized();
+  const Eigen::Vector3d u = SearchAxis(frame, axis);
   Pose turn;
   turn.R = Eigen::AngleAxisd(angle, u).toRotationMatrix();
   turn.t = frame.centroid - turn.R * frame.centroid;
@@ -54,7 +66,7 @@ Pose AxisRotation(const PrincipalFrame& frame, int axis, double angle) {
 }
 
 Pose HalfTurn(const PrincipalFrame& frame, int axis) {
-  const Eigen::Vector3d u = frame.axes.col(axis).normalized();
+  const Eigen::Vector3d u = SearchAxis(frame, axis);
   // Rotation by pi about u: 2 u u^T - I (exact).
   Pose flip;
   flip.R = 2.0 * u * u.transpose() - Eigen::Matrix3d::Identity();
@@ -68,6 +80,7 @@ std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOption
   for (int axis = 0; axis < 3; ++axis) {
     for (int k = 1; k < options.steps; ++k) hypotheses.emplace_back(axis, 2.0 * M_PI * k / options.steps);
   }
+  for (int axis = 3; axis < 13; ++axis) hypotheses.emplace_back(axis, M_PI);
   return hypotheses;
 }
 

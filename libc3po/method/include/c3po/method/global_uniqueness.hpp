@@ -6,7 +6,10 @@
 // axis, a banana or marker flipped). From the estimate T̂ the corrector is
 // restarted at rival hypotheses T̂·R_a(θ) (R_a(θ) = rotation by θ about
 // principal axis a of B̂ through its centroid; θ = k·360°/steps, k = 1 ..
-// steps-1, so the half-turns are always among them) and each rival is
+// steps-1, so the half-turns are always among them), and at the half-turns
+// about the 10 diagonals of the principal frame (ReestimateAxes 3-12: where
+// two extents are alike the principal axes are oblique to the object's own,
+// and a flip about those is reached only from a diagonal), and each rival is
 // refined. A refined rival T' that
 //   - passes oc_m with the same ε_oc and budget m as T̂ (and, for depth-image
 //     inputs, the free-space test: free_space.hpp), and
@@ -41,7 +44,8 @@ struct GlobalUniquenessOptions {
   bool reestimate = false;
   int reestimate_steps = 12;   // even, in [2, 36]
   // Rotations by k·360°/steps about each principal axis, k = 1 .. steps-1
-  // (even: the half-turns are included). 4: 90°, 180°, 270° (9 rivals).
+  // (even: the half-turns are included). 4: 90°, 180°, 270° (9 rivals; with
+  // the 10 diagonal half-turns, 19).
   int steps = 4;
   // A rival counts when Hausdorff(T̂·B̂, T'·B̂) > rival_distance; 0 = 2·eps_oc.
   // Two poses that both satisfy the guarantee lie within eps_oc + eps_w of
@@ -73,7 +77,7 @@ struct GlobalUniqueness {
   // The rival reported: the farthest one that counts; if none counts, the
   // distinct one (farther than rival_distance) with the fewest outliers;
   // axis -1 when every rival fell back within rival_distance of T̂.
-  int rival_axis = -1;          // principal axis (0 = largest extent); a restart's: ReestimateAxes column
+  int rival_axis = -1;          // ReestimateAxes column: 0-2 principal axes (0 = largest extent), 3-12 diagonals
   double rival_angle_deg = 0.0; // start rotation about it
   double rival_hausdorff = 0.0; // Hausdorff(T̂·B̂, T'·B̂)
   int rival_outliers = -1;      // its oc_m outlier count (points >= eps_oc)
@@ -90,8 +94,9 @@ struct PrincipalFrame {
 };
 PrincipalFrame ModelPrincipalFrame(const ObjectModel& object);
 
-// The rotation by `angle` (radians) about principal axis `axis` through the
-// centroid, as a model_from_model pose.
+// The rotation by `angle` (radians) about axis `axis` through the centroid,
+// as a model_from_model pose: a principal axis (0-2) or a diagonal of the
+// principal frame (3-12, the ReestimateAxes column).
 Pose AxisRotation(const PrincipalFrame& frame, int axis, double angle);
 // AxisRotation(frame, axis, pi).
 Pose HalfTurn(const PrincipalFrame& frame, int axis);
@@ -118,7 +123,8 @@ std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cl
                                    const PipelineOptions& pipeline, const PrincipalFrame& frame,
                                    const std::vector<std::pair<int, double>>& hypotheses);
 
-// The (axis, angle) hypotheses of the options (3 × (steps - 1)).
+// The (axis, angle) hypotheses of the options: 3 × (steps - 1) turns about
+// the principal axes, then the half-turns about the diagonals 3-12.
 std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOptions& options);
 
 // The 13 axes of the re-estimation (columns, unit): the principal axes (0-2),

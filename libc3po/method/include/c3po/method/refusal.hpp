@@ -53,7 +53,7 @@ std::vector<RefusalCount> CountRefusals(const std::vector<CloudOutcome>& outcome
 
 // "" when certified, else one clause per failed part joined by "; ", each
 // with its evidence (object units), e.g. "nd_global: a pose 0.032 away
-// (180 deg about principal axis 0) leaves 21 points at >= eps_oc".
+// (180 deg about axis 0) leaves 21 points at >= eps_oc" (axis: a ReestimateAxes column, 0-2 the principal axes).
 std::string RefusalSummary(const Certificate& certificate);
 
 }  // namespace c3po
