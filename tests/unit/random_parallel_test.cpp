@@ -175,6 +175,32 @@ TEST_CASE("ParallelFor runs every index exactly once") {
   }
 }
 
+TEST_CASE("ParallelFor nested in a ParallelFor body runs inline on that thread, every pair once") {
+  for (int threads : {1, 2, 3}) {
+    CAPTURE(threads);
+    const int outer = 6, inner = 50;
+    std::vector<std::atomic<int>> hits(outer * inner);
+    std::atomic<int> foreign{0};   // inner items run on another thread than their outer item
+    c3po::ParallelFor(0, outer, [&](int i) {
+      const std::thread::id mine = std::this_thread::get_id();
+      c3po::ParallelFor(0, inner, [&](int j) {
+        if (std::this_thread::get_id() != mine) foreign.fetch_add(1);
+        hits[i * inner + j].fetch_add(1);
+      }, threads);
+    }, threads);
+    int wrong = 0;
+    for (const auto& hit : hits) wrong += hit.load() == 1 ? 0 : 1;
+    CHECK(wrong == 0);
+    if (threads > 1) CHECK(foreign.load() == 0);
+    // An inner item's exception reaches the outermost caller.
+    CHECK_THROWS_AS(c3po::ParallelFor(0, outer, [&](int i) {
+      c3po::ParallelFor(0, inner, [&](int j) {
+        if (i == 3 && j == 7) throw std::runtime_error("inner");
+      }, threads);
+    }, threads), std::runtime_error);
+  }
+}
+
 TEST_CASE("ParallelFor propagates the first exception, each index runs at most once") {
   for (int threads : {1, 2, 4}) {
     CAPTURE(threads);

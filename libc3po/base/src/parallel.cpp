@@ -40,12 +40,32 @@ int IndexQueue::Stop() {
   return static_cast<int>(std::min(claimed, end_) - begin_);
 }
 
+namespace {
+
+// True while this thread runs the items of a ParallelFor (as a worker or as
+// the calling thread): a ParallelFor inside runs inline instead of starting
+// threads of its own (the cores are taken; results stay in their slots).
+thread_local bool running_parallel_items = false;
+
+class RunningParallelItems {
+ public:
+  RunningParallelItems() : previous_(running_parallel_items) { running_parallel_items = true; }
+  ~RunningParallelItems() { running_parallel_items = previous_; }
+  RunningParallelItems(const RunningParallelItems&) = delete;
+  RunningParallelItems& operator=(const RunningParallelItems&) = delete;
+
+ private:
+  bool previous_;
+};
+
+}  // namespace
+
 void ParallelFor(int begin, int end, const std::function<void(int)>& body, int threads) {
   const int count = end - begin;
   if (count <= 0) return;
   if (threads <= 0) threads = DefaultThreadCount();
   threads = std::min(threads, count);
-  if (threads == 1) {
+  if (threads == 1 || running_parallel_items) {
     for (int i = begin; i < end; ++i) body(i);
     return;
   }
@@ -54,6 +74,7 @@ void ParallelFor(int begin, int end, const std::function<void(int)>& body, int t
   std::exception_ptr first_error;
   std::mutex error_mutex;
   auto worker = [&]() {
+    const RunningParallelItems running;
     int i = 0;
     while (queue.Claim(&i)) {
       try {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "c3po/base/parallel.hpp"
 #include "c3po/geometry/registration.hpp"
 #include "c3po/method/pipeline.hpp"
 
@@ -113,10 +114,12 @@ std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud
   rival_options.certificate.max_outliers = OutlierBudget{};
   rival_options.certificate.max_outliers.count = m + pipeline.certificate.global.RivalSlack(cloud.cols());
   const PointSet queries = StridedColumns(object.sample(), 1000);
-  std::vector<RivalFit> fits;
-  fits.reserve(starts.size());
-  for (const RivalStart& start : starts) {
-    RivalFit fit;
+  // The starts are independent: both cores for one pose (inline inside a
+  // batch's worker, parallel.hpp); each fit goes to its own slot.
+  std::vector<RivalFit> fits(starts.size());
+  ParallelFor(0, static_cast<int>(starts.size()), [&](int i) {
+    const RivalStart& start = starts[static_cast<std::size_t>(i)];
+    RivalFit& fit = fits[static_cast<std::size_t>(i)];
     fit.axis = start.axis;
     fit.angle = start.angle;
     fit.start = start.scene_from_model;
@@ -132,8 +135,7 @@ std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud
       fit.keypoint_distance = (rival.keypoints - estimate.keypoints).colwise().norm().maxCoeff();
       fit.hausdorff = PosedModelHausdorff(object, queries, estimate.scene_from_model, rival.scene_from_model);
     }
-    fits.push_back(std::move(fit));
-  }
+  });
   return fits;
 }
 

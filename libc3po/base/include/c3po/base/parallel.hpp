@@ -39,6 +39,11 @@ class IndexQueue {
   std::atomic<bool> stopped_{false};
 };
 
+// Runs body(i) for i in [begin, end) on `threads` threads (0 = DefaultThreadCount()).
+// Nested: a ParallelFor called from inside another's body runs its items
+// inline on that thread (the outer one has taken the cores), so a parallel
+// step (e.g. the rival fits of one pose) uses both cores on its own and
+// none extra inside a batch.
 void ParallelFor(int begin, int end, const std::function<void(int)>& body,
                  int threads = 0);
 
