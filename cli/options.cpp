@@ -9,6 +9,7 @@
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/io/camera_io.hpp"
+#include "c3po/method/global_uniqueness.hpp"
 #include "c3po/object/object_io.hpp"
 #include "c3po/plugins/registry.hpp"
 
@@ -154,7 +155,7 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
   }
   std::string described = text;
   if (certificate.global.enabled) {
-    described += ", global rivals " + std::to_string(3 * (certificate.global.steps - 1));
+    described += ", global rivals " + std::to_string(RivalHypotheses(certificate.global).size());
   } else {
     described += ", global check off";
   }

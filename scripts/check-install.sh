@@ -122,14 +122,14 @@ echo "$found; find_package(c3po $next_minor) refused"
 # they agree on Eigen's layout only through the exported EIGEN_MAX_ALIGN_BYTES;
 # without it certify_cloud crashed with "double free or corruption".)
 section "examples"
-MUG=$PREFIX/share/c3po/annotations/mug.json
-CLOUDS=$ROOT/build-examples/mug-clouds
+OBJECT=$PREFIX/share/c3po/annotations/drill.json
+CLOUDS=$ROOT/build-examples/drill-clouds
 cloud=$CLOUDS/000000.ply
 status=0
-"$ROOT/build-examples/certify_cloud/certify_cloud" "$MUG" "$cloud" > "$WORK/example.txt" || status=$?
+"$ROOT/build-examples/certify_cloud/certify_cloud" "$OBJECT" "$cloud" > "$WORK/example.txt" || status=$?
 [[ $status -le 1 ]] || fail "certify_cloud exit $status"
 status=0
-"$PREFIX/bin/c3po" certify "$MUG" "$cloud" --detector svd --json > "$WORK/cli.jsonl" || status=$?
+"$PREFIX/bin/c3po" certify "$OBJECT" "$cloud" --detector svd --json > "$WORK/cli.jsonl" || status=$?
 [[ $status -le 1 ]] || fail "c3po certify exit $status"
 python3 - "$WORK/example.txt" "$WORK/cli.jsonl" <<'EOF'
 import json, re, sys
@@ -144,11 +144,11 @@ EOF
 # The centroid plugin (README block): without the corrector its keypoints are
 # the model keypoints centred on the cloud's centroid (ASCII or binary PLY read here).
 status=0
-"$PREFIX/bin/c3po" certify "$MUG" "$cloud" --plugin "$ROOT/build-examples/detector_plugin/libcentroid_detector.so" \
+"$PREFIX/bin/c3po" certify "$OBJECT" "$cloud" --plugin "$ROOT/build-examples/detector_plugin/libcentroid_detector.so" \
   --detector centroid --no-correct --json > "$WORK/plugin.jsonl" || status=$?
 [[ $status -le 1 ]] || fail "c3po certify --plugin exit $status"
 [[ $(wc -l < "$ROOT/centroid.jsonl") -eq 3 ]] || fail "README plugin command: expected 3 JSON lines in centroid.jsonl"
-python3 - "$cloud" "$WORK/plugin.jsonl" "$MUG" <<'EOF'
+python3 - "$cloud" "$WORK/plugin.jsonl" "$OBJECT" <<'EOF'
 import json, struct, sys
 data = open(sys.argv[1], "rb").read()
 end = data.index(b"end_header\n") + len(b"end_header\n")
@@ -190,7 +190,7 @@ EOF
 # shellcheck disable=SC2046
 c++ "$WORK/pc.cpp" -o "$WORK/pc" $(PKG_CONFIG_PATH=$PREFIX/lib/pkgconfig pkg-config --cflags --libs c3po) ||
   fail "building against c3po.pc"
-"$WORK/pc" "$MUG" "$cloud"
+"$WORK/pc" "$OBJECT" "$cloud"
 
 # --- 5. The plugin ABI check -----------------------------------------------
 section "plugin ABI check"
@@ -202,7 +202,7 @@ grep -q "C3PO_PLUGIN_ABI_VERSION $OTHER_ABI" "$WORK/abi/include/c3po/plugins/plu
 c++ -std=c++17 -shared -fPIC -fvisibility=hidden -I"$WORK/abi/include" examples/detector_plugin/centroid_detector.cpp \
   -o "$WORK/libcentroid_other_abi.so"
 status=0
-"$PREFIX/bin/c3po" certify "$MUG" "$cloud" --plugin "$WORK/libcentroid_other_abi.so" --detector centroid \
+"$PREFIX/bin/c3po" certify "$OBJECT" "$cloud" --plugin "$WORK/libcentroid_other_abi.so" --detector centroid \
   > "$WORK/abi.out" 2> "$WORK/abi.err" || status=$?
 cat "$WORK/abi.err"
 [[ $status -eq 2 ]] || fail "a plugin for ABI $OTHER_ABI: exit $status, expected 2"
