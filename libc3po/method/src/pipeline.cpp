@@ -58,15 +58,11 @@ bool Refuted(const Certificate& certificate) {
 // through the centroid by k·360°/steps.
 std::vector<RivalStart> ReestimateStarts(const ObjectModel& object, const Pose& scene_from_model, int steps) {
   const PrincipalFrame frame = ModelPrincipalFrame(object);
-  const Eigen::Matrix<double, 3, 13> axes = ReestimateAxes(frame);
   std::vector<RivalStart> starts;
-  for (int a = 0; a < axes.cols(); ++a) {
+  for (int a = 0; a < ReestimateAxes(frame).cols(); ++a) {
     for (int k = 1; k < steps; ++k) {
       const double angle = 2.0 * M_PI * k / steps;
-      Pose turn;
-      turn.R = Eigen::AngleAxisd(angle, Eigen::Vector3d(axes.col(a))).toRotationMatrix();
-      turn.t = frame.centroid - turn.R * frame.centroid;
-      starts.push_back({a, angle, scene_from_model * turn});
+      starts.push_back({a, angle, scene_from_model * AxisRotation(frame, a, angle)});
     }
   }
   return starts;
