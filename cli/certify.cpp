@@ -45,6 +45,7 @@ struct CertifyCommand {
   FrameFlags frame;
   BopFlags bop;
   SegmentOptions segment;
+  std::string evidence_erode_mask = "auto";   // resolved into segment by ResolveEvidence
   std::string bop_csv_path;
   std::string shard;
   std::string poses_path;   // certify given poses (docs/method.md "Certifying poses from any estimator")
@@ -76,11 +77,11 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
 
 // "eps_oc = ..., delta_nd = ... (object units; d = ...); m = 2%, robust loss = ...".
 std::string Settings(const CertificateOptions& certificate, const CertifyBatchOptions& options,
-                     const ObjectModel& object) {
+                     const ObjectModel& object, const std::string& evidence) {
   char text[160];
   std::snprintf(text, sizeof text, "eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g); ", certificate.eps_oc,
                 certificate.delta_nd, object.diameter());
-  return text + DescribeRobust(certificate, options.pipeline.corrector);
+  return text + DescribeRobust(certificate, options.pipeline.corrector) + evidence;
 }
 
 // "; refused by nd_global 36, oc 10": every failed part counted once per
@@ -222,7 +223,8 @@ std::string GivenPoseLines(const CertifyCommand& cmd, const GivenPoseSources& ma
 // c3po certify --poses: every hypothesis matched to a cloud is certified; per
 // instance the certified one with the best fit is chosen (given_poses.hpp).
 int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const CertifyBatchOptions& options,
-                  const std::vector<CloudSource>& clouds, const std::vector<CloudSource>& all_clouds) {
+                  const std::vector<CloudSource>& clouds, const std::vector<CloudSource>& all_clouds,
+                  const std::string& evidence) {
   const std::vector<PoseHypothesis> poses = ReadPoseList(cmd.poses_path);
   std::size_t other_shards = 0;
   const GivenPoseSources matched = MatchThisShard(object, clouds, all_clouds, poses, &other_shards);
@@ -247,7 +249,7 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
     }
     WriteFileAtomically(cmd.bop_csv_path, BopCsv(BopResultRows(matched.sources, result, written)));
   }
-  WriteReportIfAsked(cmd, object, matched.sources, result, Settings(result.certificate, options, object));
+  WriteReportIfAsked(cmd, object, matched.sources, result, Settings(result.certificate, options, object, evidence));
   if (!cmd.output_path.empty()) {
     WriteFileAtomically(cmd.output_path, json_lines);
   } else if (cmd.json) {
@@ -291,14 +293,14 @@ CertifyBatchOptions CertifyOptions(const CertifyCommand& cmd, const ObjectModel&
 
 // Every cloud given: cloud files, --data's dataset, a --depth/--mask frame,
 // --bop's instances, in that order.
-std::vector<CloudSource> CertifySources(const CertifyCommand& cmd) {
+std::vector<CloudSource> CertifySources(const CertifyCommand& cmd, const SegmentOptions& segment) {
   std::vector<CloudSource> sources = CloudFileSources(cmd.clouds);
   const auto append = [&sources](const std::vector<CloudSource>& more) {
     sources.insert(sources.end(), more.begin(), more.end());
   };
   // certify does not use ground truth: the manifest's is not even parsed.
   if (!cmd.data_dir.empty()) append(DatasetSources(ReadDataset(cmd.data_dir, /*ground_truth=*/false)));
-  if (cmd.frame.given()) append(FrameSources(ResolveFrame(cmd.frame, "c3po certify"), cmd.segment));
+  if (cmd.frame.given()) append(FrameSources(ResolveFrame(cmd.frame, "c3po certify"), segment));
   if (!cmd.bop.dir.empty()) {
     const BopInstances listed = ListBopInstances(cmd.bop.dir, cmd.bop.options);
     if (listed.instances.empty()) {
@@ -306,7 +308,7 @@ std::vector<CloudSource> CertifySources(const CertifyCommand& cmd) {
                                         (cmd.bop.options.detections_path.empty() ? "" : " in the detections") +
                                         (cmd.bop.options.targets_path.empty() ? "" : " among the targets"));
     }
-    append(BopSources(listed, cmd.segment));
+    append(BopSources(listed, segment));
   }
   if (sources.empty()) {
     throw InputError("no clouds given (CLOUD..., --data DIR, --depth/--mask or --bop DIR)");
@@ -344,10 +346,16 @@ int Run(const CertifyCommand& cmd) {
   const ObjectModel object = LoadObject(cmd.object_path);
   const CertifyBatchOptions options = CertifyOptions(cmd, object);
   const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
-  std::vector<CloudSource> sources = CertifySources(cmd);
+  SegmentOptions segment = cmd.segment;
+  ResolveEvidence(cmd.evidence_erode_mask, options.pipeline.certificate, &segment);
+  std::vector<CloudSource> sources = CertifySources(cmd, segment);
+  const bool camera_input = cmd.frame.given() || !cmd.bop.dir.empty();
+  const std::string evidence = camera_input ? DescribeEvidence(segment) : "";
   const std::vector<CloudSource> all_sources = shard && !cmd.poses_path.empty() ? sources : std::vector<CloudSource>{};
   if (shard) sources = ShardSources(sources, *shard);
-  if (!cmd.poses_path.empty()) return RunGivenPoses(cmd, object, options, sources, shard ? all_sources : sources);
+  if (!cmd.poses_path.empty()) {
+    return RunGivenPoses(cmd, object, options, sources, shard ? all_sources : sources, evidence);
+  }
   LoadPlugins(cmd.detector);
   const std::unique_ptr<Detector> detector =
       MakeDetector(cmd.detector.models.empty() ? "" : cmd.detector.models.front(),
@@ -364,7 +372,7 @@ int Run(const CertifyCommand& cmd) {
                  chosen.ToJson().c_str());
   }
   WriteCertifyResults(cmd, sources, result);
-  const std::string settings = Settings(result.certificate, options, object);
+  const std::string settings = Settings(result.certificate, options, object, evidence);
   if (!cmd.json) {
     std::printf("certified %d/%zu (oc %d, nd %d, errors %d); %s%s\n", result.certified, sources.size(), result.oc,
                 result.nd, result.errors, settings.c_str(), RefusalTally(result).c_str());
@@ -396,6 +404,7 @@ RunFunction SetupCertify(CLI::App& command) {
   AddFrameOptions(command, &cmd->frame);
   AddBopOptions(command, &cmd->bop, BopDetections::kAllowed);
   AddSegmentOptions(command, &cmd->segment);
+  AddEvidenceOption(command, &cmd->evidence_erode_mask);
   command.add_option("--bop-csv", cmd->bop_csv_path,
                      "Write BOP results CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm; score: certified first); "
                      "with --poses one row per instance: its chosen hypothesis, else its best fit")

@@ -60,6 +60,7 @@ struct EvalCommand {
   BopFlags bop;
   std::string models_info_path;
   SegmentOptions segment;
+  std::string evidence_erode_mask = "auto";   // resolved into segment by ResolveEvidence
 };
 
 // A temporary folder removed on destruction (the BOP instances as a dataset).
@@ -240,14 +241,14 @@ struct EvalData {
   Dataset dataset;
   DatasetFrames frames;
 };
-EvalData ReadEvalData(const EvalCommand& cmd, const ObjectModel& object, const std::optional<Shard>& shard,
-                      const ScratchFolder& scratch) {
+EvalData ReadEvalData(const EvalCommand& cmd, const SegmentOptions& segment, const ObjectModel& object,
+                      const std::optional<Shard>& shard, const ScratchFolder& scratch) {
   const std::string empty_part = "this part holds no clouds (choose N at most the number of " +
                                  std::string(cmd.bop.dir.empty() ? "manifest lines)" : "images with usable instances)");
   EvalData data;
   std::string data_dir = cmd.data_dir;
   if (!cmd.bop.dir.empty()) {
-    CheckSegmentOptions(cmd.segment, "c3po eval");
+    CheckSegmentOptions(segment, "c3po eval");
     auto listed_shared = std::make_shared<const BopInstances>(ListBopInstances(cmd.bop.dir, cmd.bop.options));
     const BopInstances& listed = *listed_shared;
     if (listed.instances.empty()) throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id));
@@ -255,8 +256,8 @@ EvalData ReadEvalData(const EvalCommand& cmd, const ObjectModel& object, const s
     const std::vector<BopInstance> instances = shard ? ShardBopInstances(listed.instances, *shard) : listed.instances;
     if (instances.empty()) throw InputError("--shard " + cmd.shard, empty_part);
     data_dir = scratch.path() + "/dataset";
-    const BopDatasetSummary summary = WriteDatasetFromBop(instances, object.keypoints(), cmd.segment, data_dir);
-    data.frames = BopDatasetFrames(listed_shared, instances, cmd.segment);
+    const BopDatasetSummary summary = WriteDatasetFromBop(instances, object.keypoints(), segment, data_dir);
+    data.frames = BopDatasetFrames(listed_shared, instances, segment);
     for (const std::string& reason : summary.skipped) std::cerr << "c3po eval: skipped " << reason << "\n";
     std::cerr << "c3po eval: " << summary.written << " BOP instances of obj_id " << cmd.bop.options.obj_id << " ("
               << summary.skipped.size() << " skipped)\n";
@@ -308,7 +309,13 @@ int Run(const EvalCommand& cmd) {
   cmd.report.Check();
   const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
   ScratchFolder scratch;
-  const EvalData data = ReadEvalData(cmd, object, shard, scratch);
+  SegmentOptions segment = cmd.segment;
+  ResolveEvidence(cmd.evidence_erode_mask, options.pipeline.certificate, &segment);
+  if (!cmd.bop.dir.empty()) {
+    const std::string evidence = DescribeEvidence(segment);
+    if (!evidence.empty()) std::cerr << "c3po eval: " << evidence.substr(2) << " (the estimate: the eroded mask)\n";
+  }
+  const EvalData data = ReadEvalData(cmd, segment, object, shard, scratch);
   if (!cmd.samples_path.empty()) {   // sample files hold the object's rows, not a mixed set's per-object counts
     for (std::size_t i = 0; i < data.dataset.entries.size(); ++i) {
       if (!data.dataset.Shows(i, object.name())) {
@@ -350,6 +357,7 @@ RunFunction SetupEval(CLI::App& command) {
   command.add_option("--models-info", cmd->models_info_path,
                      "BOP models_info.json (default: DIR/../models or DIR/../../models): its diameter is d");
   AddSegmentOptions(command, &cmd->segment);
+  AddEvidenceOption(command, &cmd->evidence_erode_mask);
   AddDetectorOptions(command, &cmd->detector, DetectorCount::kMany);
   command.add_option("--selftrained", cmd->selftrained,
                      "Self-trained model file: C-3PO rows (also when a model header says \"selftrained\": true); repeatable")->allow_extra_args(false);

@@ -239,7 +239,9 @@ void AddThreadsOption(CLI::App& command, int* threads, const std::string& what) 
 
 
 void AddSegmentOptions(CLI::App& command, SegmentOptions* options) {
-  command.add_option("--erode-mask", options->erode_mask, "Erode masks by K pixels (0 = off)")->capture_default_str();
+  command.add_option("--erode-mask", options->erode_mask,
+                     "Erode masks by K pixels for the estimate (the detector and the corrector; 0 = off)")
+      ->capture_default_str();
   command.add_option("--depth-edge", options->max_relative_depth_step,
                      "Drop pixels whose depth differs from a neighbour's by more than this fraction of their "
                      "depth (0 = off)")
@@ -259,6 +261,32 @@ void CheckSegmentOptions(const SegmentOptions& options, const std::string& comma
   } catch (const std::invalid_argument& e) {
     throw InputError(command, e.what());
   }
+}
+
+void AddEvidenceOption(CLI::App& command, std::string* flag) {
+  command.add_option("--evidence-erode-mask", *flag,
+                     "Erode masks by K pixels for the certificate's evidence; auto (default): 0 = every mask point "
+                     "when the budget --max-outliers is > 0 (it counts the mask's stray pixels), else the estimate's "
+                     "--erode-mask");
+}
+
+void ResolveEvidence(const std::string& flag, const CertificateOptions& certificate, SegmentOptions* segment) {
+  if (flag.empty() || flag == "auto") {
+    segment->evidence_erode_mask = certificate.max_outliers.IsZero() ? -1 : 0;
+    return;
+  }
+  char* end = nullptr;
+  const long value = std::strtol(flag.c_str(), &end, 10);
+  if (end == flag.c_str() || *end != '\0' || value < 0 || value > 1000) {
+    throw InputError("--evidence-erode-mask", "'" + flag + "' must be auto or a pixel count in [0, 1000]");
+  }
+  segment->evidence_erode_mask = static_cast<int>(value);
+}
+
+std::string DescribeEvidence(const SegmentOptions& segment) {
+  if (segment.evidence_erode_mask < 0 || segment.evidence_erode_mask == segment.erode_mask) return "";
+  if (segment.evidence_erode_mask == 0) return "; evidence: every mask point";
+  return "; evidence: mask eroded by " + std::to_string(segment.evidence_erode_mask) + " px";
 }
 
 void AddFrameOptions(CLI::App& command, FrameFlags* flags) {

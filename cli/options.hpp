@@ -131,6 +131,15 @@ constexpr const char* kManifestDetector = "manifest";
 void AddSegmentOptions(CLI::App& command, SegmentOptions* options);
 // options->Check() as an InputError naming the command.
 void CheckSegmentOptions(const SegmentOptions& options, const std::string& command);
+// --evidence-erode-mask: "auto" (default) or K pixels. Resolved into
+// segment->evidence_erode_mask: K as given; auto = 0 (the certificate judges
+// every mask point) when the certificate has an outlier budget m > 0 to count
+// the mask's stray pixels, else -1 (it judges the estimate's eroded cloud).
+// InputError("--evidence-erode-mask", ...) when neither.
+void AddEvidenceOption(CLI::App& command, std::string* flag);
+void ResolveEvidence(const std::string& flag, const CertificateOptions& certificate, SegmentOptions* segment);
+// "; evidence: every mask point" / "; evidence: mask eroded by K px" / "" (-1).
+std::string DescribeEvidence(const SegmentOptions& segment);
 
 // --depth, --mask, --label-id, --camera, --im-id, --intrinsics, --depth-scale: one frame.
 struct FrameFlags {

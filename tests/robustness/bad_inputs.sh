@@ -80,6 +80,9 @@ done
 for bad in nan -0.5 1 abc; do
   check "free_space_fraction_${bad}" "2" - --free-space-fraction one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --free-space-fraction "$bad" one_point.xyz
 done
+for bad in -1 abc 1.5 2000; do
+  check "evidence_erode_mask_${bad}" "2" - --evidence-erode-mask one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --evidence-erode-mask "$bad" one_point.xyz
+done
 python3 -c "
 import sys
 print('0.25 0.5 0.75\n' * 500, end='')" > duplicates.xyz

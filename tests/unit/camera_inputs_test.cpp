@@ -597,3 +597,53 @@ TEST_CASE("--shard K/N: disjoint contiguous parts whose concatenation is the who
         "scene_id,im_id,obj_id,score,R,t,time\n1\n2\n");
   CHECK(InputErrorOf([] { c3po::MergeShardOutputs({{"a.jsonl", "{}\nnope\n"}}, false); }) == "a.jsonl: line 2: not a JSON object");
 }
+
+TEST_CASE("the certificate's evidence: the same steps with its own erosion, the counts describe the cloud") {
+  const int w = 40, h = 30;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> noise(-0.002, 0.002);
+  DepthImage depth{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      double z = (u > 10 && u < 30 && v > 8 && v < 22) ? 0.5 : 1.5;   // a box before a wall
+      if ((u * 7 + v * 3) % 29 == 0) z = 0.0;
+      depth.z[static_cast<std::size_t>(v) * w + u] = static_cast<float>(z > 0 ? z + noise(rng) : 0.0);
+    }
+  }
+  Mask mask{w, h, std::vector<std::uint8_t>(depth.z.size(), 0)};
+  for (int v = 7; v < 24; ++v) for (int u = 9; u < 32; ++u) mask.inside[static_cast<std::size_t>(v) * w + u] = 1;
+  for (int erode : {0, 1, 3}) {
+    for (int evidence_erode : {-1, 0, 1, 2, 4}) {
+      for (int max_points : {0, 60}) {
+        CAPTURE(erode);
+        CAPTURE(evidence_erode);
+        CAPTURE(max_points);
+        c3po::SegmentOptions options;
+        options.erode_mask = erode;
+        options.evidence_erode_mask = evidence_erode;
+        options.max_points = max_points;
+        options.support_plane_distance = 0.0;
+        // Oracles: single-erosion extractions with each radius.
+        c3po::SegmentOptions core = options, judged = options;
+        core.evidence_erode_mask = -1;
+        const int judged_erode = evidence_erode < 0 ? erode : evidence_erode;   // -1: the cloud itself
+        judged.erode_mask = judged_erode;
+        judged.evidence_erode_mask = judged_erode;
+        const c3po::SegmentCloud s = c3po::ExtractSegment(depth, mask, kCamera, options, "x");
+        const c3po::SegmentCloud a = c3po::ExtractSegment(depth, mask, kCamera, core, "x");
+        const c3po::SegmentCloud b = c3po::ExtractSegment(depth, mask, kCamera, judged, "x");
+        CHECK(!a.evidence.has_value());
+        CHECK(a.evidence_points == static_cast<std::size_t>(a.cloud.cols()));
+        CHECK(s.cloud == a.cloud);
+        CHECK(s.pixels == a.pixels);
+        CHECK(s.no_depth == a.no_depth);
+        CHECK(s.removed_by_erosion == a.removed_by_erosion);
+        CHECK(s.removed_by_discontinuity == a.removed_by_discontinuity);
+        CHECK(s.removed_by_subsampling == a.removed_by_subsampling);
+        CHECK(s.evidence.has_value() == (judged_erode != erode));
+        CHECK((s.evidence ? *s.evidence : s.cloud) == b.cloud);
+        CHECK(s.evidence_points == static_cast<std::size_t>(b.cloud.cols()));
+      }
+    }
+  }
+}

@@ -242,7 +242,7 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   for (int v = 200; v < 280; ++v) {
     for (int u = 0; u < occluded->width; ++u) occluded->z[static_cast<std::size_t>(v) * occluded->width + u] = 0.5f;
   }
-  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera, std::nullopt, 0.0}, options, object.spec().eps_oc);
+  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera, std::nullopt, 0.0, nullptr}, options, object.spec().eps_oc);
   const FreeSpace behind_occluder = with_occluder.Check(frame.truth);
   CHECK(behind_occluder.passed);
   CHECK(behind_occluder.violations == 0);
@@ -255,7 +255,7 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   // Missing depth is unknown, not a violation.
   auto holes = std::make_shared<DepthImage>(*frame.view.depth);
   std::fill(holes->z.begin(), holes->z.end(), 0.0f);
-  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera, std::nullopt, 0.0}, options, object.spec().eps_oc);
+  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera, std::nullopt, 0.0, nullptr}, options, object.spec().eps_oc);
   const FreeSpace unknown = blind.Check(shifted);
   CHECK(unknown.passed);
   CHECK(unknown.measured == 0);
@@ -457,7 +457,7 @@ TEST_CASE("soundness on a table: the segmenter's plane filters rivals, yet no ce
     const SegmentCloud segment = ExtractSegment(depth, mask, camera, segment_options, "table scene");
     REQUIRE(segment.support_plane.has_value());
     if (segment.cloud.cols() < 200) continue;
-    const DepthView view{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance};
+    const DepthView view{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance, nullptr};
     const FreeSpaceTest free_space(object, view, FreeSpaceOptions{}, object.spec().eps_oc);
     CHECK(free_space.Check(truth).through_support == 0);
     std::vector<PointSet> starts = {truth * object.keypoints()};
@@ -528,7 +528,7 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
   REQUIRE(fit.has_value());
   CHECK(fit->plane.normal.dot(table.normal) > 1.0 - 1e-6);   // oriented towards the camera
   CHECK(std::abs(fit->plane.offset - table.offset) < 1e-5);
-  DepthView view{depth, camera, fit->plane, distance};
+  DepthView view{depth, camera, fit->plane, distance, nullptr};
   const FreeSpaceOptions options;
   const FreeSpaceTest test(box, view, options, box.spec().eps_oc);
 
@@ -578,7 +578,7 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
   CHECK(test.Check(raised).through_support == 0);
 
   // Without the plane, nothing is claimed about the table.
-  DepthView no_plane{depth, camera, std::nullopt, 0.0};
+  DepthView no_plane{depth, camera, std::nullopt, 0.0, nullptr};
   const FreeSpaceTest without(box, no_plane, options, box.spec().eps_oc);
   const FreeSpace unchecked = without.Check(sunk);
   CHECK_FALSE(unchecked.support_checked);
@@ -592,7 +592,7 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
     const long u = std::lround(uv.x()), v = std::lround(uv.y());
     if (u >= 0 && v >= 0 && u < camera.width && v < camera.height) blind->z[static_cast<std::size_t>(v) * camera.width + u] = 0.0f;
   }
-  const FreeSpaceTest blind_test(box, DepthView{blind, camera, fit->plane, distance}, options, box.spec().eps_oc);
+  const FreeSpaceTest blind_test(box, DepthView{blind, camera, fit->plane, distance, nullptr}, options, box.spec().eps_oc);
   CHECK(blind_test.Check(sunk).through_support == 0);
 }
 

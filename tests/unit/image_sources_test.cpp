@@ -166,3 +166,55 @@ TEST_CASE("ShardSources: parts 1..N concatenate to the list, an image's instance
     for (std::size_t i = 0; i < sources.size(); ++i) CHECK(joined[i] == sources[i].name);
   }
 }
+
+TEST_CASE("segment evidence: the pose is fitted to the cloud, the certificate judges the evidence") {
+  const ObjectModel object = test::EvaluationObject();
+  const std::vector<Pose> poses = test::EvaluationPoses(1);
+  const PointSet cloud = test::EvaluationCloud(object, poses[0], 0);
+  const PointSet detected = test::DetectedKeypoints(object, poses[0], 0);
+  // The evidence: the cloud and 30 points 0.5 m beyond its centroid (stray
+  // pixels the estimate's erosion removed).
+  const int strays = 30;
+  PointSet evidence(3, cloud.cols() + strays);
+  evidence.leftCols(cloud.cols()) = cloud;
+  const Eigen::Vector3d far = cloud.rowwise().mean() + Eigen::Vector3d(0.0, 0.0, 0.5);
+  for (int k = 0; k < strays; ++k) evidence.col(cloud.cols() + k) = far + Eigen::Vector3d(0.001 * k, 0.0, 0.0);
+  CloudSource source;
+  source.name = "s0";
+  source.given_keypoints = detected;
+  source.load_segment = [&]() {
+    SegmentCloud s = SegmentOf(cloud);
+    s.evidence = evidence;
+    s.evidence_points = static_cast<std::size_t>(evidence.cols());
+    return s;
+  };
+  CertifyBatchOptions options;
+  options.pipeline.certificate = CertificateOptions::FromObject(object.spec());
+  for (const int budget : {strays - 1, strays}) {
+    CAPTURE(budget);
+    options.pipeline.certificate.max_outliers.count = budget;
+    const PoseEstimate on_cloud = EstimateAndCertify(object, cloud, detected, options.pipeline);
+    REQUIRE(on_cloud.certificate.oc.passed);   // the strays are what fails below
+    REQUIRE(on_cloud.certificate.oc.outlier_count == 0);
+    Eigen::Index visited_points = -1;
+    const CertifyBatchResult result =
+        CertifyBatch(object, {source}, nullptr, options, {},
+                     [&](std::size_t, const PointSet& judged, const FreeSpaceTest*, CloudOutcome*) {
+                       visited_points = judged.cols();
+                     });
+    REQUIRE(result.outcomes[0].processed());
+    const PoseEstimate& e = result.outcomes[0].estimate;
+    // Oracles: the corrector on the cloud alone; Certify on the evidence.
+    CHECK((e.scene_from_model.R - on_cloud.scene_from_model.R).norm() == 0.0);
+    CHECK((e.scene_from_model.t - on_cloud.scene_from_model.t).norm() == 0.0);
+    const Certificate judged =
+        Certify(object, evidence, e.scene_from_model, e.keypoints, options.pipeline.certificate);
+    CHECK(e.certificate.oc.outlier_count == judged.oc.outlier_count);
+    CHECK(e.certificate.oc.outlier_count == strays);
+    CHECK(e.certificate.oc.passed == (budget >= strays));
+    CHECK(visited_points == evidence.cols());
+    const nlohmann::json line = nlohmann::json::parse(CertifyJsonLine(source, result.outcomes[0]));
+    CHECK(line.at("points").get<Eigen::Index>() == cloud.cols());
+    CHECK(line.at("evidence_points").get<Eigen::Index>() == evidence.cols());
+  }
+}

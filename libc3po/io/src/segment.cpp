@@ -54,6 +54,9 @@ Mask ErodeMask(const Mask& mask, int k) {
 
 void SegmentOptions::Check() const {
   if (erode_mask < 0 || erode_mask > 1000) throw std::invalid_argument("erode_mask must be in [0, 1000]");
+  if (evidence_erode_mask < -1 || evidence_erode_mask > 1000) {
+    throw std::invalid_argument("evidence_erode_mask must be -1 (none) or in [0, 1000]");
+  }
   if (!(max_relative_depth_step >= 0.0) || !std::isfinite(max_relative_depth_step)) {
     throw std::invalid_argument("max_relative_depth_step must be >= 0");
   }
@@ -93,6 +96,8 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
   result.depth = std::make_shared<const DepthImage>(depth);
   result.camera = camera;
   const Mask eroded = ErodeMask(mask, options.erode_mask);
+  const bool own_evidence = options.evidence_erode_mask >= 0 && options.evidence_erode_mask != options.erode_mask;
+  const Mask evidence_eroded = own_evidence ? ErodeMask(mask, options.evidence_erode_mask) : Mask{};
   std::optional<SupportPlaneFit> support;
   if (options.support_plane_distance > 0.0) {
     support = FitSupportPlane(depth, mask, camera, options.support_plane_distance);
@@ -101,7 +106,7 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
     result.support_plane = support->plane;
     result.support_plane_distance = options.support_plane_distance;
   }
-  std::vector<Eigen::Vector3d> kept;
+  std::vector<Eigen::Vector3d> kept, evidence;
   std::vector<std::int32_t> kept_pixels;
   for (int v = 0; v < mask.height; ++v) {
     for (int u = 0; u < mask.width; ++u) {
@@ -110,23 +115,34 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
       const float z = depth.at(u, v);
       if (!DepthImage::Valid(z)) {
         ++result.no_depth;
-      } else if (!eroded.at(u, v)) {
-        ++result.removed_by_erosion;
-      } else if (options.max_relative_depth_step > 0.0 &&
-                 OnDepthDiscontinuity(depth, u, v, options.max_relative_depth_step)) {
-        ++result.removed_by_discontinuity;
-      } else if (const Eigen::Vector3d point = camera.BackProject(u, v, z);
-                 support && support->plane.Distance(point) <= options.support_plane_distance) {
-        ++result.removed_by_plane;
-      } else {
-        kept.push_back(point);
-        kept_pixels.push_back(v * mask.width + u);
+        continue;
       }
+      const bool in_core = eroded.at(u, v), in_evidence = own_evidence && evidence_eroded.at(u, v);
+      if (!in_core) ++result.removed_by_erosion;   // the counts describe `cloud`
+      if (!in_core && !in_evidence) continue;
+      if (options.max_relative_depth_step > 0.0 && OnDepthDiscontinuity(depth, u, v, options.max_relative_depth_step)) {
+        if (in_core) ++result.removed_by_discontinuity;
+        continue;
+      }
+      const Eigen::Vector3d point = camera.BackProject(u, v, z);
+      if (support && support->plane.Distance(point) <= options.support_plane_distance) {
+        if (in_core) ++result.removed_by_plane;
+        continue;
+      }
+      if (in_evidence) evidence.push_back(point);
+      if (!in_core) continue;
+      kept.push_back(point);
+      kept_pixels.push_back(v * mask.width + u);
     }
   }
-  PointSet all(3, static_cast<Eigen::Index>(kept.size()));
-  for (std::size_t i = 0; i < kept.size(); ++i) all.col(static_cast<Eigen::Index>(i)) = kept[i];
-  result.cloud = StridedColumns(all, options.max_points);
+  const auto columns = [&](const std::vector<Eigen::Vector3d>& points) {
+    PointSet all(3, static_cast<Eigen::Index>(points.size()));
+    for (std::size_t i = 0; i < points.size(); ++i) all.col(static_cast<Eigen::Index>(i)) = points[i];
+    return StridedColumns(all, options.max_points);
+  };
+  result.cloud = columns(kept);
+  if (own_evidence) result.evidence = columns(evidence);
+  result.evidence_points = static_cast<std::size_t>(result.evidence ? result.evidence->cols() : result.cloud.cols());
   // The same columns as StridedColumns: floor(j n / k).
   const std::size_t n = kept.size(), k = static_cast<std::size_t>(result.cloud.cols());
   result.pixels.resize(k);

@@ -123,15 +123,23 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
   return sources;
 }
 
-PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts, DepthView* frame) {
+PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts, DepthView* frame,
+                         PointSet* evidence) {
   if (!source.load_segment) {
     PointSet cloud = source.load();
-    if (frame != nullptr && source.load_frame) *frame = source.load_frame();
+    DepthView view;
+    if ((frame != nullptr || evidence != nullptr) && source.load_frame) view = source.load_frame();
+    if (evidence != nullptr) *evidence = view.evidence ? *view.evidence : cloud;
+    view.evidence.reset();
+    if (frame != nullptr) *frame = std::move(view);
     return cloud;
   }
   SegmentCloud segment = source.load_segment();
   PointSet cloud = std::move(segment.cloud);
   segment.cloud.resize(3, 0);   // the counts stay for the output
+  if (!segment.evidence) segment.evidence_points = static_cast<std::size_t>(cloud.cols());
+  if (evidence != nullptr) *evidence = segment.evidence ? std::move(*segment.evidence) : cloud;
+  segment.evidence.reset();
   if (frame != nullptr) {
     frame->depth = segment.depth;
     frame->camera = segment.camera;
@@ -216,10 +224,10 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
   const auto certify_source = [&](std::size_t i, std::chrono::steady_clock::time_point start) {
     const CloudSource& source = sources[i];
     CloudOutcome& outcome = result.outcomes[i];
-    PointSet cloud;
-    DepthView view;   // image inputs: the frame, for the free-space test
+    PointSet cloud, evidence;   // estimated from `cloud`, certified against `evidence`
+    DepthView view;             // image inputs: the frame, for the free-space test
     RecordFailure(&outcome, CloudOutcome::Failure::kLoad,
-                  [&] { cloud = LoadSourceCloud(source, &outcome.segment, &view); });
+                  [&] { cloud = LoadSourceCloud(source, &outcome.segment, &view, &evidence); });
     if (!outcome.processed()) return;
     RecordFailure(&outcome, CloudOutcome::Failure::kDetect,
                   [&] { DetectKeypoints(source, cloud, detector, object.num_keypoints(), &outcome); });
@@ -228,16 +236,18 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
         object, view, options.pipeline.certificate.free_space, options.pipeline.certificate.eps_oc);
     const FreeSpaceTest* free_space_test = free_space ? &*free_space : nullptr;
     if (options.also_uncorrected) {
-      outcome.uncorrected = EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected, free_space_test);
+      outcome.uncorrected =
+          EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected, free_space_test, &evidence);
     }
-    outcome.estimate = EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline, free_space_test);
+    outcome.estimate =
+        EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline, free_space_test, &evidence);
     if (source.scene_from_model_truth && outcome.estimate.ok()) {
       outcome.truth_hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000),
                                                     *source.scene_from_model_truth, outcome.estimate.scene_from_model);
     }
     outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (visit) visit(i, cloud, free_space_test, &outcome);
-    if (options.auto_eps_oc) clouds[i] = std::move(cloud);
+    if (visit) visit(i, evidence, free_space_test, &outcome);
+    if (options.auto_eps_oc) clouds[i] = std::move(evidence);
   };
   ParallelFor(0, static_cast<int>(sources.size()), [&](int i) {
     ThrowIfInterrupted();

@@ -39,6 +39,7 @@ nlohmann::ordered_json SourceKeys(const CloudSource& source, const CloudOutcome&
     line["removed_plane"] = s.removed_by_plane;
     line["removed_subsampling"] = s.removed_by_subsampling;
     line["points"] = s.pixels.size();
+    line["evidence_points"] = s.evidence_points;
   }
   if (source.provenance && source.scene_from_model_truth) {
     const Pose& G = *source.scene_from_model_truth;

@@ -80,8 +80,10 @@ DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const
     if (it == by_cloud->end()) return DepthView{};
     // The segment is the dataset's cloud already; the frame and its support
     // plane come from the same extraction certify --bop makes.
-    const SegmentCloud segment = LoadBopInstance(it->second, options);
-    return DepthView{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance};
+    SegmentCloud segment = LoadBopInstance(it->second, options);
+    DepthView view{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance, nullptr};
+    if (segment.evidence) view.evidence = std::make_shared<const PointSet>(std::move(*segment.evidence));
+    return view;
   };
 }
 

@@ -71,8 +71,10 @@ std::vector<RivalStart> ReestimateStarts(const ObjectModel& object, const Pose& 
 // GlobalUniquenessOptions::reestimate: the refuted estimate is replaced by the
 // best restart that passes oc_m and free space, if any; a certified
 // replacement must have no other restart as a rival (AddRestartRivals).
-void Reestimate(const ObjectModel& object, const PointSet& cloud, const PipelineOptions& options,
-                const FreeSpaceTest* free_space, PoseEstimate* estimate) {
+void Reestimate(const ObjectModel& object, const PointSet& cloud, const PointSet& evidence,
+                const PipelineOptions& options, const FreeSpaceTest* free_space, PoseEstimate* estimate) {
+  // The candidates are estimates: fitted to `cloud` like the detector's; the
+  // chosen one is certified against `evidence` in full.
   const std::vector<RivalFit> fits =
       FitRivals(object, cloud, *estimate, options,
                 ReestimateStarts(object, estimate->scene_from_model, options.certificate.global.reestimate_steps), true);
@@ -88,7 +90,8 @@ void Reestimate(const ObjectModel& object, const PointSet& cloud, const Pipeline
   for (const std::size_t i : order) {
     int violations = -1;
     if (free_space && !free_space->Passes(fits[i].scene_from_model, &violations)) continue;
-    PoseEstimate restarted = EstimateAndCertify(object, cloud, fits[i].start * object.keypoints(), once, free_space);
+    PoseEstimate restarted =
+        EstimateAndCertify(object, cloud, fits[i].start * object.keypoints(), once, free_space, &evidence);
     if (!restarted.ok() || Refuted(restarted.certificate)) continue;
     restarted.detected_keypoints = estimate->detected_keypoints;
     if (restarted.certificate.certified() && options.certificate.global.enabled) {
@@ -109,8 +112,9 @@ void Reestimate(const ObjectModel& object, const PointSet& cloud, const Pipeline
 
 PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud,
                                 const PointSet& detected_keypoints, const PipelineOptions& options,
-                                const FreeSpaceTest* free_space) {
+                                const FreeSpaceTest* free_space, const PointSet* evidence) {
   options.Check();
+  const PointSet& judged = evidence ? *evidence : cloud;
   const auto start = std::chrono::steady_clock::now();
   PoseEstimate estimate;
   estimate.detected_keypoints = detected_keypoints;
@@ -137,11 +141,11 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
   estimate.keypoints = estimate.correction.keypoints;
   estimate.scene_from_model = estimate.correction.scene_from_model;
   if (estimate.ok()) {
-    estimate.certificate = Certify(object, cloud, estimate.scene_from_model, estimate.keypoints,
+    estimate.certificate = Certify(object, judged, estimate.scene_from_model, estimate.keypoints,
                                    options.certificate);
-    CompleteCertificate(object, cloud, options, free_space, &estimate);
+    CompleteCertificate(object, judged, options, free_space, &estimate);
     if (options.correct && options.certificate.global.reestimate && Refuted(estimate.certificate)) {
-      Reestimate(object, cloud, options, free_space, &estimate);
+      Reestimate(object, cloud, judged, options, free_space, &estimate);
     }
   } else {
     estimate.certificate.oc.eps_oc = options.certificate.eps_oc;

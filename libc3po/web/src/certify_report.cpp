@@ -98,7 +98,7 @@ std::vector<ReportView> CertifyReportViews(const ObjectModel& object, const std:
     const CloudOutcome& outcome = result.outcomes[i];
     PointSet cloud;
     try {
-      cloud = LoadSourceCloud(source);
+      LoadSourceCloud(source, nullptr, nullptr, &cloud);   // the evidence: outlier indices refer to it
     } catch (const std::exception&) {
       continue;
     }

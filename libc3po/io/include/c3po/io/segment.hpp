@@ -15,6 +15,11 @@
 // Every step's removed count is reported: mask_pixels = no_depth +
 // removed_by_erosion + removed_by_discontinuity + removed_by_plane +
 // removed_by_subsampling + cloud.cols().
+// The certificate's evidence can be a second cloud from the same steps with
+// the mask eroded by `evidence_erode_mask` instead (0: every mask pixel): the
+// estimate is fitted to the eroded core, the certificate judges it against
+// everything the mask shows, its stray points counted by the budget m
+// (docs/method.md "Evidence: the whole mask").
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -45,6 +50,7 @@ Mask ErodeMask(const Mask& mask, int k);
 
 struct SegmentOptions {
   int erode_mask = 4;                      // pixels; 0 = off
+  int evidence_erode_mask = -1;            // pixels, for SegmentCloud::evidence; -1 = no evidence of its own
   double max_relative_depth_step = 0.02;   // 0 = filter off
   double support_plane_distance = 0.01;    // metres; 0 = off
   int max_points = 5000;                   // 0 = every point
@@ -60,6 +66,10 @@ struct SegmentCloud {
   std::size_t removed_by_discontinuity = 0;
   std::size_t removed_by_plane = 0;        // step 4
   std::size_t removed_by_subsampling = 0;
+  // The certificate's evidence: steps 1-5 with the mask eroded by
+  // evidence_erode_mask; nullopt = `cloud` itself (-1, or the two erosions equal).
+  std::optional<PointSet> evidence;
+  std::size_t evidence_points = 0;         // its point count, kept when the clouds are released
   // The frame it came from (the free-space test renders the posed model into
   // it, method/free_space.hpp); shared, released by the batch after use.
   std::shared_ptr<const DepthImage> depth;

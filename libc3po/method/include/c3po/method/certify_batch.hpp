@@ -75,10 +75,13 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
 // null; without the depth image) before a segment too small to use is
 // refused; `frame` (when not null) receives the segment's depth image and
 // camera for the free-space test (free_space.hpp), or the source's
-// load_frame(). Throws InputError naming the source (unreadable file, empty
-// or too small segment).
+// load_frame(); `evidence` (when not null) the cloud the certificate judges:
+// the segment's evidence (segment.hpp: the mask eroded by
+// evidence_erode_mask), the frame's (DepthView::evidence), else the cloud
+// itself. Throws
+// InputError naming the source (unreadable file, empty or too small segment).
 PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts = nullptr,
-                         DepthView* frame = nullptr);
+                         DepthView* frame = nullptr, PointSet* evidence = nullptr);
 
 struct CertifyBatchOptions {
   PipelineOptions pipeline;           // corrector + certificate thresholds (absolute)
@@ -120,7 +123,8 @@ struct CertifyBatchResult {
 };
 
 // Called in the worker thread right after cloud `index` is certified, while
-// the cloud is in memory (eval refines with ICP there), with the frame's
+// the cloud is in memory (eval refines with ICP there; the cloud the
+// certificate judged, LoadSourceCloud's evidence), with the frame's
 // free-space test the estimate was certified with (nullptr: none). Not
 // called for clouds that failed to load.
 using CloudVisitor = std::function<void(std::size_t index, const PointSet& cloud, const FreeSpaceTest* free_space,

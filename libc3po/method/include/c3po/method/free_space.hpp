@@ -79,6 +79,10 @@ struct DepthView {
   PinholeCamera camera;
   std::optional<Plane> support;   // the frame's support plane (oriented towards the camera)
   double support_distance = 0.0;  // D: the plane's inlier distance
+  // The certificate's cloud when it is not the source's (a dataset entry
+  // written from a BOP segment: the segment's evidence, segment.hpp); null =
+  // the source's cloud.
+  std::shared_ptr<const PointSet> evidence;
   bool valid() const { return depth && depth->width > 0 && depth->height > 0; }
 };
 

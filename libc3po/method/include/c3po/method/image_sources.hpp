@@ -29,8 +29,10 @@ std::vector<CloudSource> ShardSources(const std::vector<CloudSource>& sources, c
 std::vector<BopInstance> ShardBopInstances(const std::vector<BopInstance>& instances, const Shard& shard);
 // The depth frames of a dataset written from BOP instances (WriteDatasetFromBop,
 // eval --bop): an entry's frame is its instance's depth image, camera and
-// support plane (the instance's segment under `options`, extracted when
-// asked); an entry no instance names has none.
+// support plane, and its evidence when `options` gives it one of its own
+// (the instance's segment under `options`, extracted when asked: the
+// dataset's cloud is that segment's `cloud`); an entry no instance names has
+// none.
 // `listed` keeps the instances' detections alive.
 DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const std::vector<BopInstance>& instances,
                                const SegmentOptions& options);

@@ -39,9 +39,13 @@ struct PoseEstimate {
 };
 
 // `free_space`: the depth frame's free-space test (image inputs), else nullptr.
+// `evidence`: the cloud the certificate judges (oc_m, nd, the rival and
+// weak-motion refits, re-estimation's candidates), when it is not `cloud`:
+// image inputs fit the pose to the eroded mask and certify it against the
+// whole one (segment.hpp); nullptr = `cloud`.
 PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud,
                                 const PointSet& detected_keypoints, const PipelineOptions& options,
-                                const FreeSpaceTest* free_space = nullptr);
+                                const FreeSpaceTest* free_space = nullptr, const PointSet* evidence = nullptr);
 
 // The parts of the certificate that need more than the pose and the cloud's
 // distances (EstimateAndCertify calls it after Certify; callers that decide a
