@@ -181,7 +181,8 @@ std::string CertifyErrorJsonLine(const std::string& cloud, const std::string& er
 // The same for a batch outcome, with the provenance keys of image inputs
 // after "cloud" (docs/camera_inputs.md "JSON line keys"): scene_id, im_id,
 // gt_id, obj_id (detection_score), then pixels, no_depth, removed_erosion,
-// removed_discontinuity, removed_subsampling, points, then gt_R, gt_t (BOP
+// removed_discontinuity, removed_plane, removed_subsampling, points,
+// evidence_points (the certificate's cloud), then gt_R, gt_t (BOP
 // ground truth, metres); error lines carry them too.
 std::string CertifyJsonLine(const CloudSource& source, const CloudOutcome& outcome);
 
