@@ -48,6 +48,21 @@ double SphereDepth(const c3po::PinholeCamera& K, int u, int v, const Eigen::Vect
   return (-b - std::sqrt(disc)) / (2 * a);
 }
 
+// A near box (0.5 m) in front of a far wall (1.5 m), holes, noise.
+DepthImage BoxBeforeWall(int w, int h, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> noise(-0.002, 0.002);
+  DepthImage depth{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      double z = (u > 10 && u < 30 && v > 8 && v < 22) ? 0.5 : 1.5;
+      if ((u * 7 + v * 3) % 29 == 0) z = 0.0;
+      depth.z[static_cast<std::size_t>(v) * w + u] = static_cast<float>(z > 0 ? z + noise(rng) : 0.0);
+    }
+  }
+  return depth;
+}
+
 Mask RandomMask(int w, int h, unsigned seed, double p) {
   std::mt19937 rng(seed);
   std::bernoulli_distribution on(p);
@@ -180,17 +195,7 @@ TEST_CASE("erosion equals the brute-force (2k+1)^2 window test, the image border
 
 TEST_CASE("preprocessing: counts add up, the discontinuity filter equals brute force, the bound strides") {
   const int w = 40, h = 30;
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> noise(-0.002, 0.002);
-  DepthImage depth{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      // A near box (0.5 m) in front of a far wall (1.5 m), holes, noise.
-      double z = (u > 10 && u < 30 && v > 8 && v < 22) ? 0.5 : 1.5;
-      if ((u * 7 + v * 3) % 29 == 0) z = 0.0;
-      depth.z[static_cast<std::size_t>(v) * w + u] = static_cast<float>(z > 0 ? z + noise(rng) : 0.0);
-    }
-  }
+  const DepthImage depth = BoxBeforeWall(w, h, 3);
   Mask mask{w, h, std::vector<std::uint8_t>(depth.z.size(), 0)};
   for (int v = 7; v < 24; ++v) for (int u = 9; u < 32; ++u) mask.inside[static_cast<std::size_t>(v) * w + u] = 1;   // bleeds by ~2 px
   for (int erode : {0, 1, 2}) {
@@ -600,16 +605,7 @@ TEST_CASE("--shard K/N: disjoint contiguous parts whose concatenation is the who
 
 TEST_CASE("the certificate's evidence: the same steps with its own erosion, the counts describe the cloud") {
   const int w = 40, h = 30;
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> noise(-0.002, 0.002);
-  DepthImage depth{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      double z = (u > 10 && u < 30 && v > 8 && v < 22) ? 0.5 : 1.5;   // a box before a wall
-      if ((u * 7 + v * 3) % 29 == 0) z = 0.0;
-      depth.z[static_cast<std::size_t>(v) * w + u] = static_cast<float>(z > 0 ? z + noise(rng) : 0.0);
-    }
-  }
+  const DepthImage depth = BoxBeforeWall(w, h, 5);
   Mask mask{w, h, std::vector<std::uint8_t>(depth.z.size(), 0)};
   for (int v = 7; v < 24; ++v) for (int u = 9; u < 32; ++u) mask.inside[static_cast<std::size_t>(v) * w + u] = 1;
   for (int erode : {0, 1, 3}) {

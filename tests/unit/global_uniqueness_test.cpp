@@ -242,7 +242,8 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   for (int v = 200; v < 280; ++v) {
     for (int u = 0; u < occluded->width; ++u) occluded->z[static_cast<std::size_t>(v) * occluded->width + u] = 0.5f;
   }
-  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera, std::nullopt, 0.0, nullptr}, options, object.spec().eps_oc);
+  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera, std::nullopt, 0.0, nullptr}, options,
+                                    object.spec().eps_oc);
   const FreeSpace behind_occluder = with_occluder.Check(frame.truth);
   CHECK(behind_occluder.passed);
   CHECK(behind_occluder.violations == 0);
@@ -255,7 +256,8 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   // Missing depth is unknown, not a violation.
   auto holes = std::make_shared<DepthImage>(*frame.view.depth);
   std::fill(holes->z.begin(), holes->z.end(), 0.0f);
-  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera, std::nullopt, 0.0, nullptr}, options, object.spec().eps_oc);
+  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera, std::nullopt, 0.0, nullptr}, options,
+                            object.spec().eps_oc);
   const FreeSpace unknown = blind.Check(shifted);
   CHECK(unknown.passed);
   CHECK(unknown.measured == 0);
@@ -592,7 +594,8 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
     const long u = std::lround(uv.x()), v = std::lround(uv.y());
     if (u >= 0 && v >= 0 && u < camera.width && v < camera.height) blind->z[static_cast<std::size_t>(v) * camera.width + u] = 0.0f;
   }
-  const FreeSpaceTest blind_test(box, DepthView{blind, camera, fit->plane, distance, nullptr}, options, box.spec().eps_oc);
+  const FreeSpaceTest blind_test(box, DepthView{blind, camera, fit->plane, distance, nullptr}, options,
+                                 box.spec().eps_oc);
   CHECK(blind_test.Check(sunk).through_support == 0);
 }
 
