@@ -273,6 +273,9 @@ int RunGivenPoses(const CertifyCommand& cmd, const ObjectModel& object, const Ce
   return instances_certified == static_cast<int>(verdicts.size()) && !verdicts.empty() ? 0 : 1;
 }
 
+// Depth frames (--depth/--mask, --bop) rather than ready-made clouds.
+bool CameraInput(const CertifyCommand& cmd) { return cmd.frame.given() || !cmd.bop.dir.empty(); }
+
 // The batch options from the flags: corrector, thresholds, and the measured
 // defaults of camera inputs (options.hpp InputKind), printed in the summary
 // and carried by every JSON line.
@@ -281,7 +284,7 @@ CertifyBatchOptions CertifyOptions(const CertifyCommand& cmd, const ObjectModel&
   options.pipeline.correct = !cmd.no_correct;
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
-  const InputKind input = cmd.frame.given() || !cmd.bop.dir.empty() ? InputKind::kCameraFrames : InputKind::kClouds;
+  const InputKind input = CameraInput(cmd) ? InputKind::kCameraFrames : InputKind::kClouds;
   ResolveRobust(cmd.robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
   options.auto_eps_oc = cmd.thresholds.auto_eps_oc();
   if (options.auto_eps_oc && !cmd.shard.empty()) {
@@ -349,8 +352,7 @@ int Run(const CertifyCommand& cmd) {
   SegmentOptions segment = cmd.segment;
   ResolveEvidence(cmd.evidence_erode_mask, options.pipeline.certificate, &segment);
   std::vector<CloudSource> sources = CertifySources(cmd, segment);
-  const bool camera_input = cmd.frame.given() || !cmd.bop.dir.empty();
-  const std::string evidence = camera_input ? DescribeEvidence(segment) : "";
+  const std::string evidence = CameraInput(cmd) ? DescribeEvidence(segment) : "";
   const std::vector<CloudSource> all_sources = shard && !cmd.poses_path.empty() ? sources : std::vector<CloudSource>{};
   if (shard) sources = ShardSources(sources, *shard);
   if (!cmd.poses_path.empty()) {

@@ -124,12 +124,12 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
 }
 
 PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts, DepthView* frame,
-                         PointSet* evidence) {
+                         std::optional<PointSet>* evidence) {
   if (!source.load_segment) {
     PointSet cloud = source.load();
     DepthView view;
     if ((frame != nullptr || evidence != nullptr) && source.load_frame) view = source.load_frame();
-    if (evidence != nullptr) *evidence = view.evidence ? *view.evidence : cloud;
+    if (evidence != nullptr && view.evidence) *evidence = *view.evidence;
     view.evidence.reset();
     if (frame != nullptr) *frame = std::move(view);
     return cloud;
@@ -138,7 +138,7 @@ PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>*
   PointSet cloud = std::move(segment.cloud);
   segment.cloud.resize(3, 0);   // the counts stay for the output
   if (!segment.evidence) segment.evidence_points = static_cast<std::size_t>(cloud.cols());
-  if (evidence != nullptr) *evidence = segment.evidence ? std::move(*segment.evidence) : cloud;
+  if (evidence != nullptr) *evidence = std::move(segment.evidence);
   segment.evidence.reset();
   if (frame != nullptr) {
     frame->depth = segment.depth;
@@ -224,8 +224,9 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
   const auto certify_source = [&](std::size_t i, std::chrono::steady_clock::time_point start) {
     const CloudSource& source = sources[i];
     CloudOutcome& outcome = result.outcomes[i];
-    PointSet cloud, evidence;   // estimated from `cloud`, certified against `evidence`
-    DepthView view;             // image inputs: the frame, for the free-space test
+    PointSet cloud;                    // the estimate's cloud
+    std::optional<PointSet> evidence;  // the certificate's, when it is another (image inputs)
+    DepthView view;                    // image inputs: the frame, for the free-space test
     RecordFailure(&outcome, CloudOutcome::Failure::kLoad,
                   [&] { cloud = LoadSourceCloud(source, &outcome.segment, &view, &evidence); });
     if (!outcome.processed()) return;
@@ -235,19 +236,20 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
     const std::optional<FreeSpaceTest> free_space = MakeFreeSpaceTest(
         object, view, options.pipeline.certificate.free_space, options.pipeline.certificate.eps_oc);
     const FreeSpaceTest* free_space_test = free_space ? &*free_space : nullptr;
+    const PointSet* judged = evidence ? &*evidence : nullptr;
     if (options.also_uncorrected) {
       outcome.uncorrected =
-          EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected, free_space_test, &evidence);
+          EstimateAndCertify(object, cloud, outcome.detected_keypoints, uncorrected, free_space_test, judged);
     }
     outcome.estimate =
-        EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline, free_space_test, &evidence);
+        EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline, free_space_test, judged);
     if (source.scene_from_model_truth && outcome.estimate.ok()) {
       outcome.truth_hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000),
                                                     *source.scene_from_model_truth, outcome.estimate.scene_from_model);
     }
     outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (visit) visit(i, evidence, free_space_test, &outcome);
-    if (options.auto_eps_oc) clouds[i] = std::move(evidence);
+    if (visit) visit(i, evidence ? *evidence : cloud, free_space_test, &outcome);
+    if (options.auto_eps_oc) clouds[i] = evidence ? std::move(*evidence) : std::move(cloud);
   };
   ParallelFor(0, static_cast<int>(sources.size()), [&](int i) {
     ThrowIfInterrupted();

@@ -98,7 +98,9 @@ std::vector<ReportView> CertifyReportViews(const ObjectModel& object, const std:
     const CloudOutcome& outcome = result.outcomes[i];
     PointSet cloud;
     try {
-      LoadSourceCloud(source, nullptr, nullptr, &cloud);   // the evidence: outlier indices refer to it
+      std::optional<PointSet> evidence;   // outlier indices refer to the certificate's cloud
+      cloud = LoadSourceCloud(source, nullptr, nullptr, &evidence);
+      if (evidence) cloud = std::move(*evidence);
     } catch (const std::exception&) {
       continue;
     }

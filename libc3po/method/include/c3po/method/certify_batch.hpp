@@ -75,13 +75,13 @@ std::vector<CloudSource> InMemorySources(const std::vector<PointSet>& clouds,
 // null; without the depth image) before a segment too small to use is
 // refused; `frame` (when not null) receives the segment's depth image and
 // camera for the free-space test (free_space.hpp), or the source's
-// load_frame(); `evidence` (when not null) the cloud the certificate judges:
-// the segment's evidence (segment.hpp: the mask eroded by
-// evidence_erode_mask), the frame's (DepthView::evidence), else the cloud
-// itself. Throws
+// load_frame(); `evidence` (when not null) receives the cloud the
+// certificate judges when it is not the returned one: the segment's evidence
+// (segment.hpp: the mask eroded by evidence_erode_mask) or the frame's
+// (DepthView::evidence); nullopt = the returned cloud itself. Throws
 // InputError naming the source (unreadable file, empty or too small segment).
 PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>* segment_counts = nullptr,
-                         DepthView* frame = nullptr, PointSet* evidence = nullptr);
+                         DepthView* frame = nullptr, std::optional<PointSet>* evidence = nullptr);
 
 struct CertifyBatchOptions {
   PipelineOptions pipeline;           // corrector + certificate thresholds (absolute)
