@@ -81,7 +81,10 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                    "nd without the global rival search (restarts of the corrector at turned poses; on by default)");
   command.add_flag("--reestimate", flags->reestimate,
                    "When the estimate fails oc or free space, restart the corrector at turns about 13 axes and "
-                   "certify the best fit that passes instead, unless another restart fits too (off by default)");
+                   "certify the best fit that passes instead, unless another restart fits too (default: on for "
+                   "certify's and eval's depth-image/BOP input, off for clouds and selftrain)");
+  command.add_flag("--no-reestimate", flags->no_reestimate, "No re-estimation, whatever the input")
+      ->excludes("--reestimate");
   command.add_option("--reestimate-steps", flags->reestimate_steps,
                      "--reestimate starts: rotations by k*360/N deg about each of 13 axes (N even, default 12)");
   command.add_flag("--no-weak-motion-check", flags->no_weak_motion_check,
@@ -94,7 +97,7 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                    "Depth-image inputs: no free-space test (on by default)");
   command.add_option("--free-space-fraction", flags->free_space_fraction,
                      "Depth-image inputs: largest fraction of the measured silhouette pixels seen behind the posed "
-                     "model (default 0.05)");
+                     "model (default 0.03)");
 }
 
 void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& object,
@@ -123,7 +126,8 @@ void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& 
   }
   certificate->global.enabled = !flags.no_global_check;
   certificate->local.weak_motion_check = !flags.no_weak_motion_check;
-  certificate->global.reestimate = flags.reestimate;
+  const bool reestimate_by_default = input == InputKind::kCameraFrames && flags.reestimate_camera_frames;
+  certificate->global.reestimate = !flags.no_reestimate && (flags.reestimate || reestimate_by_default);
   certificate->global.steps = flags.global_steps;
   certificate->global.reestimate_steps = flags.reestimate_steps;
   if (flags.reestimate_steps < 2 || flags.reestimate_steps > 36 || flags.reestimate_steps % 2 != 0) {
@@ -156,6 +160,7 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
   std::string described = text;
   if (certificate.global.enabled) {
     described += ", global rivals " + std::to_string(RivalHypotheses(certificate.global).size());
+    if (certificate.global.reestimate) described += ", re-estimation on";
   } else {
     described += ", global check off";
   }
@@ -170,6 +175,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (flags.no_global_check) line += " --no-global-check";
   if (flags.no_weak_motion_check) line += " --no-weak-motion-check";
   if (flags.reestimate) line += " --reestimate";
+  if (flags.no_reestimate) line += " --no-reestimate";
   if (flags.global_steps != 4) line += " --global-steps " + std::to_string(flags.global_steps);
   if (flags.reestimate_steps != 12) line += " --reestimate-steps " + std::to_string(flags.reestimate_steps);
   if (flags.no_free_space) line += " --no-free-space";

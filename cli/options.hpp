@@ -75,6 +75,10 @@ struct RobustFlags {
   std::string nd_min_eigenvalue;   // "" = default; 0 = local test off
   bool no_global_check = false;    // --no-global-check: nd without the rival search
   bool reestimate = false;         // --reestimate: restart a refuted estimate at the rival turns
+  bool no_reestimate = false;      // --no-reestimate
+  // The default without either flag for InputKind::kCameraFrames (certify,
+  // eval: on; selftrain sets it off -- its rounds certify every instance again).
+  bool reestimate_camera_frames = true;
   bool no_weak_motion_check = false;   // --no-weak-motion-check: a single weak motion fails nd
   int global_steps = 4;            // --global-steps
   int reestimate_steps = 12;       // --reestimate-steps
@@ -97,7 +101,9 @@ enum class InputKind {
   // was measured sound on real frames only with free space (without it, 8
   // false certificates of 200: mustard flips); an object with sets keeps 0
   // (nd_m with a percentage budget needs more than m points within delta_nd
-  // of every set keypoint, which a small delta_nd cannot supply).
+  // of every set keypoint, which a small delta_nd cannot supply). A refuted
+  // estimate is re-estimated (RobustFlags::reestimate_camera_frames; the
+  // mask is the object's, so a second basin is worth seconds).
   kCameraFrames,
 };
 // Fills the certificate's budget and local test and the corrector's kernel

@@ -123,6 +123,8 @@ void ResolveOptions(const ObjectModel& object, SelftrainCommand* cmd) {
   const InputKind input = !cmd->camera.given()    ? InputKind::kClouds
                           : cmd->data_dir.empty() ? InputKind::kCameraFrames
                                                   : InputKind::kCameraSegments;
+  // Re-estimation stays opt-in here: every round certifies every instance again.
+  cmd->robust.reestimate_camera_frames = false;
   ResolveRobust(cmd->robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
   if (!cmd->symmetry_tolerance.empty()) {
     options.pseudo_labels.symmetry_tolerance =

@@ -115,6 +115,20 @@ summary() {   # the certify summary's budget and kernel
 [ "$(summary c.out)" == "m = 0, robust loss = tls" ] || fail "certify --bop --no-free-space: '$(summary c.out)'"
 "$C3PO" certify "$NOSETS" --data data --detector svd -o c.jsonl > c.out 2>&1 || true
 [ "$(summary c.out)" == "m = 0, robust loss = none" ] || fail "certify --data defaults: '$(summary c.out)'"
+# Re-estimation: on for certify's and eval's frames, off for clouds and
+# selftrain; a flag wins, and the two flags exclude each other.
+grep -q "re-estimation on" c.out && fail "certify --data re-estimates by default: $(grep 're-estimation' c.out)"
+"$C3PO" certify "$NOSETS" --data data --detector svd --reestimate -o c.jsonl > c.out 2>&1 || true
+grep -q "re-estimation on" c.out || fail "certify --data --reestimate: $(head -3 c.out)"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
+grep -q "re-estimation on" c.out || fail "certify --bop does not re-estimate by default: $(head -3 c.out)"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --no-reestimate -o c.jsonl > c.out 2>&1 || true
+grep -q "re-estimation on" c.out && fail "certify --bop --no-reestimate re-estimates"
+bad_value "--reestimate" "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --reestimate --no-reestimate
+"$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --no-icp > e.out 2>&1 || fail "eval --bop exited $?"
+grep -q "re-estimation on" e.out || fail "eval --bop does not re-estimate by default: $(grep 'outlier budget' e.out)"
+"$C3PO" eval "$NOSETS" --data data --detector svd --no-icp > e.out 2>&1 || fail "eval --data exited $?"
+grep -q "re-estimation off" e.out || fail "eval --data re-estimates by default: $(grep 'outlier budget' e.out)"
 "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --no-icp > e.out 2>&1 || fail "eval --bop exited $?: $(tail -1 e.out)"
 grep -q "outlier budget m = 2%,.*robust kernel tls" e.out || fail "eval --bop defaults: $(grep 'outlier budget' e.out)"
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
@@ -139,6 +153,7 @@ grep -q "outlier budget m = 0,.*robust kernel none" e.out || fail "eval --data d
 if [ $pointnet -eq 1 ]; then
   "$C3PO" selftrain "$NOSETS" --model cube.model --bop bop --obj-id 3 --copies 2 --epochs 1 -o self_bop.model     > s.out 2>&1 || fail "selftrain --bop exited $?: $(tail -1 s.out)"
   [ "$(summary s.out)" == "m = 2%, robust loss = tls" ] || fail "selftrain --bop defaults: '$(summary s.out)'"
+  grep -q "re-estimation on" s.out && fail "selftrain --bop re-estimates by default"
   "$C3PO" selftrain "$NOSETS" --model cube.model --bop bop --obj-id 3 --data data --copies 2 --epochs 1 \
     -o self_mixed.model > s.out 2>&1 || fail "selftrain --bop --data exited $?: $(tail -1 s.out)"
   [ "$(summary s.out)" == "m = 0, robust loss = tls" ] || fail "selftrain --bop --data defaults: '$(summary s.out)'"

@@ -69,14 +69,14 @@ std::string SettingsLines(const Evaluation& e) {
   out << line;
   std::snprintf(line, sizeof line,
                 "Certificates: eps_oc = %.6g (%s), delta_nd = %.6g (%s), outlier budget m = %s, local nd %s; "
-                "corrector %s solver, %s loss, robust kernel %s.\n",
+                "corrector %s solver, %s loss, robust kernel %s; re-estimation %s.\n",
                 o.pipeline.certificate.eps_oc, Percent(o.pipeline.certificate.eps_oc, e.diameter).c_str(),
                 o.pipeline.certificate.delta_nd, Percent(o.pipeline.certificate.delta_nd, e.diameter).c_str(),
                 o.pipeline.certificate.max_outliers.ToString().c_str(),
                 o.pipeline.certificate.local_nondegeneracy
                     ? (">= " + std::to_string(o.pipeline.certificate.local.min_eigenvalue)).c_str() : "off",
                 ToString(o.pipeline.corrector.solver), ToString(o.pipeline.corrector.loss),
-                ToString(o.pipeline.corrector.robust_loss));
+                ToString(o.pipeline.corrector.robust_loss), o.pipeline.certificate.global.reestimate ? "on" : "off");
   out << line;
   return out.str();
 }
