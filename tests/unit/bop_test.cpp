@@ -41,6 +41,18 @@ std::string Id6(int id) {
   return text;
 }
 
+// The real YCB-Video frames in BOP layout (../shared/data; the tests using
+// them skip when absent) and their objects annotated as the measurements in
+// docs/method.md annotate them.
+const std::string kRealFrames = c3po::test::SharedData() + "/real/ycbv-bop";
+bool HaveRealFrames() { return fs::exists(kRealFrames + "/test"); }
+std::string AnnotateRealObject(const c3po::test::TempDir& dir, int obj_id) {
+  const std::string object = dir / ("obj" + std::to_string(obj_id) + ".json");
+  REQUIRE(c3po::test::RunC3po("annotate " + kRealFrames + "/models/obj_" + Id6(obj_id) +
+                              ".ply --units mm --auto 12 --seed 1 -o " + object).status == 0);
+  return object;
+}
+
 // Renders `images` frames of the drill (obj_id 1) and the box (obj_id 2) side
 // by side (RenderScene, as synth --format bop does) into a BOP scene folder
 // with 1-based im_ids, float32 rotations and the given depth_scale (which the
@@ -419,15 +431,14 @@ TEST_CASE("an instance with an empty mask is an error line, the others go on") {
 
 TEST_CASE("real YCB-Video frames: certify --bop runs and every line carries the ids"
           * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
-  const std::string root = c3po::test::SharedData() + "/real/ycbv-bop";
-  if (!fs::exists(root + "/test")) {
-    MESSAGE("skipped: " << root << " is absent");
+  if (!HaveRealFrames()) {
+    MESSAGE("skipped: " << kRealFrames << " is absent");
     return;
   }
   c3po::test::TempDir dir("bop_ycbv");
-  REQUIRE(c3po::test::RunC3po("annotate " + root + "/models/obj_000005.ply --units mm --auto 12 --seed 1 -o " + dir / "obj5.json").status == 0);
+  const std::string object = AnnotateRealObject(dir, 5);
   // Without re-estimation (the default for --bop): the ids are the point here, not seconds of restarts.
-  const auto run = c3po::test::RunC3po("certify " + dir / "obj5.json" + " --bop " + root +
+  const auto run = c3po::test::RunC3po("certify " + object + " --bop " + kRealFrames +
                                        "/test --obj-id 5 --detector svd --json --no-reestimate");
   CHECK((run.status == 0 || run.status == 1));
   const auto lines = JsonLines(run.output);
@@ -440,19 +451,17 @@ TEST_CASE("real YCB-Video frames: certify --bop runs and every line carries the 
 
 TEST_CASE("real YCB-Video bananas: judging the whole mask certifies more, and nothing beyond 2 cm"
           * doctest::test_suite("heavy")) {  // left out of the sanitizer run (scripts/sanitize.sh)
-  const std::string root = c3po::test::SharedData() + "/real/ycbv-bop";
-  if (!fs::exists(root + "/test")) {
-    MESSAGE("skipped: " << root << " is absent");
+  if (!HaveRealFrames()) {
+    MESSAGE("skipped: " << kRealFrames << " is absent");
     return;
   }
   c3po::test::TempDir dir("bop_ycbv_evidence");
-  REQUIRE(c3po::test::RunC3po("annotate " + root + "/models/obj_000010.ply --units mm --auto 12 --seed 1 -o " +
-                              dir / "obj10.json").status == 0);
+  const std::string object = AnnotateRealObject(dir, 10);
   // The same estimates (the eroded mask; no re-estimation, which would
   // choose them by the evidence), judged against the whole mask (the default
   // with m = 2 %) and against the eroded mask itself.
   const auto certified = [&](const std::string& evidence) {
-    const auto run = c3po::test::RunC3po("certify " + dir / "obj10.json" + " --bop " + root +
+    const auto run = c3po::test::RunC3po("certify " + object + " --bop " + kRealFrames +
                                          "/test --obj-id 10 --detector svd --json --no-reestimate" + evidence);
     CHECK((run.status == 0 || run.status == 1));
     int count = 0;
@@ -476,9 +485,8 @@ TEST_CASE("real YCB-Video frames: every ground-truth pose passes the free-space 
   // The limit (FreeSpaceOptions::max_fraction) refutes rivals; it is sound
   // only while the truth itself stays under it. The dataset's own poses,
   // given as a BOP results CSV, certified as they are.
-  const std::string root = c3po::test::SharedData() + "/real/ycbv-bop";
-  if (!fs::exists(root + "/test")) {
-    MESSAGE("skipped: " << root << " is absent");
+  if (!HaveRealFrames()) {
+    MESSAGE("skipped: " << kRealFrames << " is absent");
     return;
   }
   c3po::test::TempDir dir("bop_ycbv_truth");
@@ -487,7 +495,7 @@ TEST_CASE("real YCB-Video frames: every ground-truth pose passes the free-space 
   csv << "scene_id,im_id,obj_id,score,R,t,time\n";
   std::set<int> objects;
   int instances = 0;
-  for (const auto& scene : fs::directory_iterator(root + "/test")) {
+  for (const auto& scene : fs::directory_iterator(kRealFrames + "/test")) {
     const json gt = json::parse(c3po::ReadFileToString(scene.path().string() + "/scene_gt.json"));
     for (const auto& [im_id, entries] : gt.items()) {
       for (const json& entry : entries) {
@@ -506,11 +514,10 @@ TEST_CASE("real YCB-Video frames: every ground-truth pose passes the free-space 
   int checked = 0;
   double largest = 0.0;
   for (const int obj_id : objects) {
-    const std::string id = std::to_string(obj_id), object = dir / ("obj" + id + ".json");
-    REQUIRE(c3po::test::RunC3po("annotate " + root + "/models/obj_" + Id6(obj_id) +
-                                ".ply --units mm --auto 12 --seed 1 -o " + object).status == 0);
-    const auto run = c3po::test::RunC3po("certify " + object + " --bop " + root + "/test --obj-id " + id + " --poses " +
-                                         dir / "truth.csv" + " --no-correct --no-global-check --json");
+    const std::string object = AnnotateRealObject(dir, obj_id);
+    const auto run = c3po::test::RunC3po("certify " + object + " --bop " + kRealFrames + "/test --obj-id " +
+                                         std::to_string(obj_id) + " --poses " + dir / "truth.csv" +
+                                         " --no-correct --no-global-check --json");
     CHECK((run.status == 0 || run.status == 1));
     for (const json& line : JsonLines(run.output)) {
       REQUIRE(line.contains("free_space_measured"));
