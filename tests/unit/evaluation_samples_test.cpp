@@ -26,6 +26,7 @@ EvaluationOptions Options() {
   o.pipeline.certificate.eps_oc = 0.01 / 3.0;
   o.pipeline.certificate.delta_nd = 0.02 / 7.0;
   o.pipeline.certificate.max_outliers.fraction = 0.02;
+  o.pipeline.certificate.global.reestimate = true;   // not the default: the settings line must carry it
   o.icp.max_correspondence_distance = kInf;
   o.ransac.inlier_threshold = 0.0123456789;
   o.ransac.seed = 42;
@@ -118,6 +119,7 @@ TEST_CASE("merged sample files of contiguous parts give the whole evaluation's t
     CHECK(IsEvaluationSamples(parts.front().second));
     const Evaluation merged = MergeEvaluationSamples(parts);
     CHECK(EvaluationTable(merged) == EvaluationTable(whole));
+    CHECK(merged.options.pipeline.certificate.global.reestimate);
     REQUIRE(merged.options.symmetries.size() == 1);
     CHECK(merged.options.symmetries[0].R == whole.options.symmetries[0].R);
     CHECK(merged.options.symmetries[0].t == whole.options.symmetries[0].t);
@@ -167,4 +169,16 @@ TEST_CASE("merge --eval refuses parts out of order, missing, of another run, tru
   CHECK(ErrorOf({{"a", a}, {"y", bad_symmetry}}).find("y: line 1: symmetries: each pose is 12 numbers") != std::string::npos);
   CHECK_FALSE(IsEvaluationSamples("{\"cloud\": \"x.ply\"}\n"));
   CHECK(ErrorOf({}) == "c3po merge: no parts");
+}
+
+TEST_CASE("merge --eval: a sample file written before re-estimation was recorded reads as without it") {
+  const std::vector<std::vector<SampleResult>> all = {Samples(4, 5), Samples(5, 5), Samples(6, 5)};
+  std::string part = EvaluationSamplesJsonl(Slice(all, 0, 5), "1/1");
+  const std::string key = "\"reestimate\":true,";
+  const std::size_t at = part.find(key);
+  REQUIRE(at != std::string::npos);
+  part.erase(at, key.size());
+  const Evaluation merged = MergeEvaluationSamples({{"old.jsonl", part}});
+  CHECK(!merged.options.pipeline.certificate.global.reestimate);
+  CHECK(EvaluationTable(merged).find("re-estimation off") != std::string::npos);
 }

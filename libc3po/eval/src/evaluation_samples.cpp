@@ -80,6 +80,7 @@ json SettingsJson(const EvaluationOptions& o) {
   s["max_outliers_fraction"] = Exact(c.max_outliers.fraction);
   s["local_nondegeneracy"] = c.local_nondegeneracy;
   s["local_min_eigenvalue"] = Exact(c.local.min_eigenvalue);
+  s["reestimate"] = c.global.reestimate;
   s["solver"] = ToString(k.solver);
   s["loss"] = ToString(k.loss);
   s["robust_loss"] = ToString(k.robust_loss);
@@ -144,6 +145,8 @@ EvaluationOptions OptionsFromSettings(const json& s, const std::string& where) {
   c.max_outliers.fraction = Number(s, "max_outliers_fraction", where);
   c.local_nondegeneracy = Bool(s, "local_nondegeneracy", where);
   c.local.min_eigenvalue = Number(s, "local_min_eigenvalue", where);
+  // Absent in files written before re-estimation was named (= off, as it was by default then).
+  c.global.reestimate = s.contains("reestimate") && Bool(s, "reestimate", where);
   o.pipeline.corrector.kappa = Number(s, "kappa", where);
   o.pipeline.corrector.theta = Number(s, "theta", where);
   o.run_icp = Bool(s, "run_icp", where);
