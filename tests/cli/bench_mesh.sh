@@ -19,7 +19,7 @@ awk -v nv="$vertices" -v nf="$faces" 'BEGIN { print "OFF"; print nv, nf, 0 }
 [ "$(wc -l < out.txt)" -eq 2 ] || { cat out.txt; fail "expected one line per mesh"; }
 for file in "$MUG" mug.off; do
   line=$(grep -F "mesh $file:" out.txt) || { cat out.txt; fail "no line for $file"; }
-  echo "$line" | grep -q ": $vertices vertices, $faces triangles, .* ms per load = .* MB/s" \
+  grep -q ": $vertices vertices, $faces triangles, .* ms per load = .* MB/s" <<< "$line" \
     || fail "$file: expected $vertices vertices and $faces triangles: $line"
 done
 

@@ -15,8 +15,8 @@ cp "$SRC/annotations/mug.json" "$SRC/annotations/mug.obj" .
 
 # Listing names the keypoints of every set.
 out=$("$C3PO" indicators mug.json) || fail "list exit $?"
-echo "$out" | grep -q "3 indicator sets" || fail "list: $out"
-echo "$out" | grep -q "set 1: {9 handle_middle}" || fail "list names: $out"
+grep -q "3 indicator sets" <<< "$out" || fail "list: $out"
+grep -q "set 1: {9 handle_middle}" <<< "$out" || fail "list names: $out"
 
 # Invalid edits: exit 2, one line naming the problem, file unchanged.
 cp mug.json original.json
@@ -36,14 +36,15 @@ cmp -s mug.json original.json || fail "a refused --auto changed the file"
 cmp -s mug.json original.json || fail "-o changed the input"
 grep -q '"indicator_sets"' edited.json || fail "edited.json"
 out=$("$C3PO" indicators edited.json)
-echo "$out" | grep -q "set 2: {0 rim_handle_side, 4 base_handle_side}" || fail "edited sets: $out"
-echo "$out" | grep -q "set 0: {9 handle_middle}" || fail "remove 0: $out"
+grep -q "set 2: {0 rim_handle_side, 4 base_handle_side}" <<< "$out" || fail "edited sets: $out"
+grep -q "set 0: {9 handle_middle}" <<< "$out" || fail "remove 0: $out"
 
 # In place: a backup of the original, then --clear.
 cp edited.json before_clear.json
 "$C3PO" indicators edited.json --clear > /dev/null || fail "clear"
 cmp -s edited.json.bak before_clear.json || fail "the backup is not the file before the edit"
-"$C3PO" indicators edited.json | grep -q "0 indicator sets (nd = 1 always)" || fail "cleared"
+out=$("$C3PO" indicators edited.json)
+grep -q "0 indicator sets (nd = 1 always)" <<< "$out" || fail "cleared: $out"
 
 # --write without --auto is refused.
 "$C3PO" indicators mug.json --write > /dev/null 2>&1
@@ -53,16 +54,16 @@ cmp -s edited.json.bak before_clear.json || fail "the backup is not the file bef
 # sets, the views in which no handle keypoint is seen fail.
 "$C3PO" synth mug.json -o depth --kind depth --count 24 --points 600 --seed 4 > /dev/null 2>&1 || fail "synth"
 out=$("$C3PO" indicators mug.json --coverage depth) || fail "coverage exit $?"
-echo "$out" | grep -q "24 views" || fail "coverage: $out"
+grep -q "24 views" <<< "$out" || fail "coverage: $out"
 nd=$(echo "$out" | sed -n 's/.*nd = 1 in \([0-9]*\) of 24 views.*/\1/p')
 [ -n "$nd" ] && [ "$nd" -lt 24 ] && [ "$nd" -gt 0 ] || fail "handle sets should pass some views, not all: $out"
 out=$("$C3PO" indicators edited.json --coverage depth) || fail "coverage (no sets)"
-echo "$out" | grep -q "nd = 1 in 24 of 24 views" || fail "no sets => always: $out"
+grep -q "nd = 1 in 24 of 24 views" <<< "$out" || fail "no sets => always: $out"
 
 # --auto prints without writing; --write -o writes the sets and the evidence.
 cp mug.json before_auto.json
 out=$("$C3PO" indicators mug.json --auto --views 10 --test-views 6 --points 400 2>/dev/null) || fail "auto exit $?"
-echo "$out" | grep -q "precision" || fail "auto output: $out"
+grep -q "precision" <<< "$out" || fail "auto output: $out"
 cmp -s mug.json before_auto.json || fail "--auto without --write changed the file"
 "$C3PO" indicators mug.json --auto --views 10 --test-views 6 --points 400 --write -o auto.json > /dev/null 2>&1 || fail "auto --write"
 grep -q '"indicator_sets_auto"' auto.json || fail "no evidence in auto.json"
