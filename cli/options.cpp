@@ -1,6 +1,7 @@
 // Shared command-line options (options.hpp).
 #include "options.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -96,9 +97,45 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_flag("--no-free-space", flags->no_free_space,
                    "Depth-image inputs: no free-space test (on by default)");
   command.add_option("--free-space-fraction", flags->free_space_fraction,
-                     "Depth-image inputs: largest fraction of the measured silhouette pixels seen behind the posed "
-                     "model (default 0.03)");
+                     "Depth-image inputs: a rival pose (or re-estimation candidate) that sees through more than this "
+                     "fraction of its measured silhouette pixels is refuted (default 0.03)");
+  command.add_option("--free-space-accept", flags->free_space_accept,
+                     "Depth-image inputs: the estimate is certified only if it sees through at most this fraction "
+                     "(default 0.015, at most --free-space-fraction)");
 }
+
+namespace {
+
+// A fraction in [0, 1) given to `option`, or exit status 2 naming it.
+double ParseFraction(const std::string& text, const char* option) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !(value >= 0) || !(value < 1)) {
+    throw InputError(option, "'" + text + "' must be a number in [0, 1)");
+  }
+  return value;
+}
+
+// --free-space-fraction F alone lowers the acceptance limit to F when F is
+// smaller; an acceptance limit above the refutation limit is refused.
+void ResolveFreeSpaceLimits(const RobustFlags& flags, FreeSpaceOptions* options) {
+  if (!flags.free_space_fraction.empty()) {
+    options->max_fraction = ParseFraction(flags.free_space_fraction, "--free-space-fraction");
+    options->accept_fraction = std::min(options->accept_fraction, options->max_fraction);
+  }
+  if (!flags.free_space_accept.empty()) {
+    options->accept_fraction = ParseFraction(flags.free_space_accept, "--free-space-accept");
+    if (options->accept_fraction > options->max_fraction) {
+      char limit[32];
+      std::snprintf(limit, sizeof limit, "%g", options->max_fraction);
+      throw InputError("--free-space-accept",
+                       "'" + flags.free_space_accept + "' must not exceed the free-space fraction (" + limit + ")");
+    }
+  }
+}
+
+}  // namespace
+
 
 void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& object,
                    CertificateOptions* certificate, CorrectorOptions* corrector) {
@@ -137,14 +174,7 @@ void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& 
     throw InputError("--global-steps", std::to_string(flags.global_steps) + " must be even and in [2, 36]");
   }
   certificate->free_space.enabled = !flags.no_free_space;
-  if (!flags.free_space_fraction.empty()) {
-    char* end = nullptr;
-    const double value = std::strtod(flags.free_space_fraction.c_str(), &end);
-    if (*end != '\0' || !(value >= 0) || !(value < 1)) {
-      throw InputError("--free-space-fraction", "'" + flags.free_space_fraction + "' must be a number in [0, 1)");
-    }
-    certificate->free_space.max_fraction = value;
-  }
+  ResolveFreeSpaceLimits(flags, &certificate->free_space);
 }
 
 std::string DescribeRobust(const CertificateOptions& certificate, const CorrectorOptions& corrector) {
@@ -180,6 +210,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (flags.reestimate_steps != 12) line += " --reestimate-steps " + std::to_string(flags.reestimate_steps);
   if (flags.no_free_space) line += " --no-free-space";
   if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;
+  if (!flags.free_space_accept.empty()) line += " --free-space-accept " + flags.free_space_accept;
   return line;
 }
 

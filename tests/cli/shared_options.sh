@@ -20,7 +20,7 @@ for c in "${commands[@]}"; do
   # shellcheck disable=SC2086
   "$C3PO" $c --help > "help.txt" 2>&1 || fail "$c --help exited $?"
   for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue --no-global-check \
-      --global-steps --no-free-space --free-space-fraction; do
+      --global-steps --no-free-space --free-space-fraction --free-space-accept; do
     grep -q -- "$flag" help.txt || fail "$c --help lacks $flag"
   done
   grep -q "allow_extra_args\|->" help.txt && fail "$c --help shows code: $(grep 'allow_extra_args\|->' help.txt)"
@@ -150,6 +150,21 @@ PY
 grep -q "outlier budget m = 0,.*robust kernel tls" e.out || fail "eval --bop --no-free-space: $(grep 'outlier budget' e.out)"
 "$C3PO" eval "$NOSETS" --data data --detector svd --no-icp > e.out 2>&1 || fail "eval --data exited $?: $(tail -1 e.out)"
 grep -q "outlier budget m = 0,.*robust kernel none" e.out || fail "eval --data defaults: $(grep 'outlier budget' e.out)"
+# Two free-space limits: the estimate's (--free-space-accept, default 0.015)
+# and the rivals' (--free-space-fraction, 0.03); the JSON carries the one
+# applied to the estimate; --free-space-fraction alone lowers the estimate's
+# to it; an estimate's limit above the rivals' is an error.
+limit() { python3 -c "import json,sys; print(sorted({json.loads(l)['free_space_limit'] for l in open(sys.argv[1])}))" "$1"; }
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
+[ "$(limit c.jsonl)" == "[0.015]" ] || fail "certify --bop free-space limit: $(limit c.jsonl)"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --free-space-fraction 0.01 -o c.jsonl > c.out 2>&1 || true
+[ "$(limit c.jsonl)" == "[0.01]" ] || fail "--free-space-fraction 0.01 leaves the estimate's limit at $(limit c.jsonl)"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --free-space-accept 0.025 -o c.jsonl > c.out 2>&1 || true
+[ "$(limit c.jsonl)" == "[0.025]" ] || fail "--free-space-accept 0.025: limit $(limit c.jsonl)"
+bad_value --free-space-accept "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --free-space-accept 0.05
+bad_value --free-space-accept "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --free-space-fraction 0.01 \
+  --free-space-accept 0.02
+bad_value --free-space-accept "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --free-space-accept abc
 if [ $pointnet -eq 1 ]; then
   "$C3PO" selftrain "$NOSETS" --model cube.model --bop bop --obj-id 3 --copies 2 --epochs 1 -o self_bop.model     > s.out 2>&1 || fail "selftrain --bop exited $?: $(tail -1 s.out)"
   [ "$(summary s.out)" == "m = 2%, robust loss = tls" ] || fail "selftrain --bop defaults: '$(summary s.out)'"

@@ -347,6 +347,45 @@ TEST_CASE("free space: the whole silhouette shifts together (a pose within the t
   CHECK(std::abs(close_check.shift_v + focal * 0.008 / close.t.z()) <= slack);
 }
 
+TEST_CASE("free space: two limits -- the estimate is judged at accept_fraction, a rival at max_fraction") {
+  // The pudding-like box of the test above, turned by 90 deg: it overhangs
+  // the observed face, so it sees through some fraction of its silhouette.
+  const ObjectModel box = PlainBox({0.11, 0.09, 0.035});
+  Pose truth;
+  truth.R = Eigen::AngleAxisd(0.15, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  truth.t = {0.01, -0.02, 0.6};
+  const Frame frame = RenderFrame(box, truth);
+  Pose turned = truth;
+  turned.R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix() * truth.R;
+  // Oracle: with both limits 0 the shift search minimises the violations
+  // themselves; no shift has fewer than v0 violations, and no shift measures
+  // more than the whole silhouette.
+  FreeSpaceOptions zero;
+  zero.max_fraction = 0.0;
+  zero.accept_fraction = 0.0;
+  const FreeSpace fewest = FreeSpaceTest(box, frame.view, zero, box.spec().eps_oc).Check(turned);
+  REQUIRE(fewest.violations > 0);
+  REQUIRE(fewest.measured > 0);
+  const double at_best = static_cast<double>(fewest.violations) / fewest.measured;
+  FreeSpaceOptions options;
+  options.max_fraction = std::min(0.9, at_best + 0.001);                              // some shift is within it
+  options.accept_fraction = 0.5 * fewest.violations / static_cast<double>(fewest.silhouette);  // none is
+  REQUIRE(options.accept_fraction < options.max_fraction);
+  const FreeSpaceTest test(box, frame.view, options, box.spec().eps_oc);
+  const FreeSpace as_estimate = test.Check(turned);
+  CHECK_FALSE(as_estimate.passed);
+  CHECK(as_estimate.limit == options.accept_fraction);
+  int violations = -1;
+  CHECK(test.Passes(turned, &violations));      // as a rival it is not refuted
+  CHECK(violations <= options.max_fraction * fewest.silhouette);
+  // The truth passes both; the limits' order is checked.
+  CHECK(test.Check(truth).passed);
+  CHECK(test.Passes(truth, nullptr));
+  FreeSpaceOptions inverted;
+  inverted.accept_fraction = inverted.max_fraction + 0.01;
+  CHECK_THROWS_AS(inverted.Check(), std::invalid_argument);
+}
+
 namespace {
 
 // The object's points as the frame's camera sees them (DepthRenderer's

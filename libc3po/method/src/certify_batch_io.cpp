@@ -143,6 +143,7 @@ void AddFreeSpaceKeys(const FreeSpace& f, nlohmann::ordered_json* out) {
   line["free_space_measured"] = f.measured;
   line["free_space_silhouette"] = f.silhouette;
   line["free_space_tolerance"] = f.tolerance;
+  line["free_space_limit"] = f.limit;
   line["free_space_shift_px"] = {f.shift_u, f.shift_v};
   line["through_support"] = f.support_checked ? nlohmann::ordered_json(f.through_support) : nlohmann::ordered_json(nullptr);
 }

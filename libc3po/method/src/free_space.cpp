@@ -15,6 +15,9 @@ void FreeSpaceOptions::Check() const {
     throw std::invalid_argument("free-space minimum tolerance must be >= 0");
   }
   if (!(max_fraction >= 0.0 && max_fraction < 1.0)) throw std::invalid_argument("free-space fraction must be in [0, 1)");
+  if (!(accept_fraction >= 0.0 && accept_fraction <= max_fraction)) {
+    throw std::invalid_argument("free-space acceptance fraction must be in [0, the free-space fraction]");
+  }
   if (border_pixels < 0 || border_pixels > 64) throw std::invalid_argument("free-space border must be in [0, 64] pixels");
 }
 
@@ -101,7 +104,7 @@ ShiftCount CountAtShift(const std::vector<CountedPixel>& counted, const DepthIma
 }
 
 // Violations beyond the allowed fraction (<= 0 passes): what the shift search minimises.
-double Excess(const ShiftCount& c, double max_fraction) { return c.violations - max_fraction * c.measured; }
+double Excess(const ShiftCount& c, double fraction) { return c.violations - fraction * c.measured; }
 
 // Model sample points more than `margin` beyond the support plane whose
 // pixel sees the plane (observed point within `distance` of it).
@@ -125,7 +128,11 @@ int CountThroughSupport(const PointSet& sample, const Pose& camera_from_model, c
 }  // namespace
 
 FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
-  FreeSpace result = CheckSilhouette(camera_from_model);
+  return Evaluate(camera_from_model, options_.accept_fraction);
+}
+
+FreeSpace FreeSpaceTest::Evaluate(const Pose& camera_from_model, double limit) const {
+  FreeSpace result = CheckSilhouette(camera_from_model, limit);
   if (!result.checked || !view_.support) return result;
   // The table is solid where it is seen (free_space.hpp "Support").
   const PointSet& sample = object_.sample();
@@ -133,14 +140,15 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   result.support_points = static_cast<int>(sample.cols());
   result.through_support = CountThroughSupport(sample, camera_from_model, *view_.depth, view_.camera, *view_.support,
                                                view_.support_distance, tolerance_ + view_.support_distance);
-  result.support_passed = !(result.through_support > options_.max_fraction * result.support_points);
+  result.support_passed = !(result.through_support > limit * result.support_points);
   result.passed = result.passed && result.support_passed;
   return result;
 }
 
-FreeSpace FreeSpaceTest::CheckSilhouette(const Pose& camera_from_model) const {
+FreeSpace FreeSpaceTest::CheckSilhouette(const Pose& camera_from_model, double limit) const {
   FreeSpace result;
   result.tolerance = tolerance_;
+  result.limit = limit;
   if (!renderer_ || !options_.enabled) return result;
   result.checked = true;
   renderer_->Render(object_.mesh(), camera_from_model);
@@ -160,7 +168,7 @@ FreeSpace FreeSpaceTest::CheckSilhouette(const Pose& camera_from_model) const {
   ShiftCount best = CountAtShift(counted, depth, 0, 0);
   // Ties go to the smaller shift (the evidence then says how far the pose is off, not where a tie fell).
   const auto better = [&](const ShiftCount& a, const ShiftCount& b) {
-    const double ea = Excess(a, options_.max_fraction), eb = Excess(b, options_.max_fraction);
+    const double ea = Excess(a, limit), eb = Excess(b, limit);
     return ea < eb || (ea == eb && std::abs(a.du) + std::abs(a.dv) < std::abs(b.du) + std::abs(b.dv));
   };
   const auto consider = [&](int du, int dv) {
@@ -190,7 +198,7 @@ FreeSpace FreeSpaceTest::CheckSilhouette(const Pose& camera_from_model) const {
   result.shift_u = best.du;
   result.shift_v = best.dv;
   result.reach = reach;
-  result.silhouette_passed = Excess(best, options_.max_fraction) <= 0.0;
+  result.silhouette_passed = Excess(best, limit) <= 0.0;
   result.passed = result.silhouette_passed;
   return result;
 }
@@ -203,7 +211,7 @@ std::optional<FreeSpaceTest> MakeFreeSpaceTest(const ObjectModel& object, const 
 }
 
 bool FreeSpaceTest::Passes(const Pose& scene_from_model, int* violations) const {
-  const FreeSpace result = Check(scene_from_model);
+  const FreeSpace result = Evaluate(scene_from_model, options_.max_fraction);
   if (violations) *violations = result.violations;
   return result.passed;
 }

@@ -37,8 +37,8 @@ std::string Evidence(CertificatePart part, const Certificate& c) {
     case CertificatePart::kOcKeypoints:
       return Format("keypoints %.3g from the posed model's (eps_oc %.3g)", oc.max_keypoint_distance, oc.eps_oc);
     case CertificatePart::kFreeSpace:
-      return Format("%d of %d measured pixels see behind the posed model (tolerance %.3g)", f.violations,
-                    f.measured, f.tolerance);
+      return Format("%d of %d measured pixels see behind the posed model (tolerance %.3g, limit %.3g)",
+                    f.violations, f.measured, f.tolerance, f.limit);
     case CertificatePart::kSupport:
       return Format("%d of %d model points below the table", f.through_support, f.support_points);
     case CertificatePart::kNdSets: {
