@@ -190,10 +190,11 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
   std::string described = text;
   if (certificate.global.enabled) {
     described += ", global rivals " + std::to_string(RivalHypotheses(certificate.global).size());
-    if (certificate.global.reestimate) described += ", re-estimation on";
   } else {
     described += ", global check off";
   }
+  // Re-estimation runs with or without the rival search (pipeline.cpp).
+  if (certificate.global.reestimate) described += ", re-estimation on";
   return described;
 }
 

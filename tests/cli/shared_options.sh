@@ -124,6 +124,8 @@ grep -q "re-estimation on" c.out || fail "certify --data --reestimate: $(head -3
 grep -q "re-estimation on" c.out || fail "certify --bop does not re-estimate by default: $(head -3 c.out)"
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --no-reestimate -o c.jsonl > c.out 2>&1 || true
 grep -q "re-estimation on" c.out && fail "certify --bop --no-reestimate re-estimates"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --no-global-check -o c.jsonl > c.out 2>&1 || true
+grep -q "global check off, re-estimation on" c.out || fail "certify --bop --no-global-check: $(head -3 c.out)"
 bad_value "--reestimate" "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --reestimate --no-reestimate
 "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --no-icp > e.out 2>&1 || fail "eval --bop exited $?"
 grep -q "re-estimation on" e.out || fail "eval --bop does not re-estimate by default: $(grep 'outlier budget' e.out)"
