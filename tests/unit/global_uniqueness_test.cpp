@@ -278,14 +278,24 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   CHECK(RefusalSummary(e.certificate).rfind(expected, 0) == 0);
 }
 
-TEST_CASE("free space: the whole silhouette shifts together (a pose within the tolerance passes, a turn that overhangs two sides fails)") {
-  // A 11 x 9 x 3.5 cm box (a pudding box) seen almost face-on at 0.6 m in
-  // front of a wall: the tolerance is 1 cm, so a pose 1 cm off moves the
-  // image by at most f * 1 cm / z ~ 9 px.
-  const ObjectModel box = PlainBox({0.11, 0.09, 0.035});
+namespace {
+
+// A 11 x 9 x 3.5 cm box (a pudding box) seen almost face-on at 0.6 m in
+// front of a wall.
+Pose PuddingBoxTruth() {
   Pose truth;
   truth.R = Eigen::AngleAxisd(0.15, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
   truth.t = {0.01, -0.02, 0.6};
+  return truth;
+}
+
+}  // namespace
+
+TEST_CASE("free space: the whole silhouette shifts together (a pose within the tolerance passes, a turn that overhangs two sides fails)") {
+  // The tolerance is 1 cm, so a pose 1 cm off moves the image by at most
+  // f * 1 cm / z ~ 9 px.
+  const ObjectModel box = PlainBox({0.11, 0.09, 0.035});
+  const Pose truth = PuddingBoxTruth();
   const Frame frame = RenderFrame(box, truth);
   const FreeSpaceOptions options;
   const FreeSpaceTest test(box, frame.view, options, box.spec().eps_oc);
@@ -348,12 +358,10 @@ TEST_CASE("free space: the whole silhouette shifts together (a pose within the t
 }
 
 TEST_CASE("free space: two limits -- the estimate is judged at accept_fraction, a rival at max_fraction") {
-  // The pudding-like box of the test above, turned by 90 deg: it overhangs
-  // the observed face, so it sees through some fraction of its silhouette.
+  // The pudding box of the test above, turned by 90 deg: it overhangs the
+  // observed face, so it sees through some fraction of its silhouette.
   const ObjectModel box = PlainBox({0.11, 0.09, 0.035});
-  Pose truth;
-  truth.R = Eigen::AngleAxisd(0.15, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
-  truth.t = {0.01, -0.02, 0.6};
+  const Pose truth = PuddingBoxTruth();
   const Frame frame = RenderFrame(box, truth);
   Pose turned = truth;
   turned.R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix() * truth.R;
