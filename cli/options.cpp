@@ -102,16 +102,20 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_option("--free-space-accept", flags->free_space_accept,
                      "Depth-image inputs: the estimate is certified only if it sees through at most this fraction "
                      "(default 0.015, at most --free-space-fraction)");
+  command.add_option("--outside-mask-fraction", flags->outside_mask,
+                     "Depth-image inputs: the estimate is certified only if at most this fraction of its measured "
+                     "silhouette pixels show its surface outside the segment's mask (default 0.05; 1 = off)");
 }
 
 namespace {
 
-// A fraction in [0, 1) given to `option`, or exit status 2 naming it.
-double ParseFraction(const std::string& text, const char* option) {
+// A fraction in [0, 1) (or [0, 1] when `one_allowed`) given to `option`, or
+// exit status 2 naming it.
+double ParseFraction(const std::string& text, const char* option, bool one_allowed = false) {
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !(value >= 0) || !(value < 1)) {
-    throw InputError(option, "'" + text + "' must be a number in [0, 1)");
+  if (end == text.c_str() || *end != '\0' || !(value >= 0) || !(one_allowed ? value <= 1 : value < 1)) {
+    throw InputError(option, "'" + text + "' must be a number in [0, 1" + (one_allowed ? "]" : ")"));
   }
   return value;
 }
@@ -132,10 +136,12 @@ void ResolveFreeSpaceLimits(const RobustFlags& flags, FreeSpaceOptions* options)
                        "'" + flags.free_space_accept + "' must not exceed the free-space fraction (" + limit + ")");
     }
   }
+  if (!flags.outside_mask.empty()) {
+    options->outside_mask_fraction = ParseFraction(flags.outside_mask, "--outside-mask-fraction", true);
+  }
 }
 
 }  // namespace
-
 
 void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& object,
                    CertificateOptions* certificate, CorrectorOptions* corrector) {
@@ -212,6 +218,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (flags.no_free_space) line += " --no-free-space";
   if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;
   if (!flags.free_space_accept.empty()) line += " --free-space-accept " + flags.free_space_accept;
+  if (!flags.outside_mask.empty()) line += " --outside-mask-fraction " + flags.outside_mask;
   return line;
 }
 

@@ -81,6 +81,9 @@ for bad in nan -0.5 1 abc; do
   check "free_space_fraction_${bad}" "2" - --free-space-fraction one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --free-space-fraction "$bad" one_point.xyz
   check "free_space_accept_${bad}" "2" - --free-space-accept one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --free-space-accept "$bad" one_point.xyz
 done
+for bad in nan -0.5 1.5 abc; do
+  check "outside_mask_${bad}" "2" - --outside-mask-fraction one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --outside-mask-fraction "$bad" one_point.xyz
+done
 for bad in -1 abc 1.5 2000; do
   check "evidence_erode_mask_${bad}" "2" - --evidence-erode-mask one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --evidence-erode-mask "$bad" one_point.xyz
 done

@@ -4,6 +4,7 @@
 // force, camera JSON forms and errors, sharding.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -191,6 +192,29 @@ TEST_CASE("erosion equals the brute-force (2k+1)^2 window test, the image border
     }
   }
   CHECK(c3po::ErodeMask(FullMask(5, 4), 3).Count() == 20);
+}
+
+TEST_CASE("mask distance equals the brute-force chessboard distance to the nearest mask pixel") {
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const Mask mask = RandomMask(29 + static_cast<int>(seed), 19, seed, 0.03 * seed);   // sparse to dense
+    const std::vector<int> distance = c3po::MaskDistance(mask);
+    REQUIRE(distance.size() == mask.inside.size());
+    for (int v = 0; v < mask.height; ++v) {
+      for (int u = 0; u < mask.width; ++u) {
+        int nearest = mask.width + mask.height;
+        for (int y = 0; y < mask.height; ++y) {
+          for (int x = 0; x < mask.width; ++x) {
+            if (mask.at(x, y)) nearest = std::min(nearest, std::max(std::abs(x - u), std::abs(y - v)));
+          }
+        }
+        REQUIRE(distance[static_cast<std::size_t>(v) * mask.width + u] == nearest);
+      }
+    }
+  }
+  Mask empty = FullMask(6, 4);
+  std::fill(empty.inside.begin(), empty.inside.end(), 0);
+  const std::vector<int> none = c3po::MaskDistance(empty);
+  CHECK(std::all_of(none.begin(), none.end(), [](int d) { return d == 10; }));
 }
 
 TEST_CASE("preprocessing: counts add up, the discontinuity filter equals brute force, the bound strides") {

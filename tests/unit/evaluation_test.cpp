@@ -505,7 +505,7 @@ TEST_CASE("frames: every row's certificate includes the frame's free space, a fr
     image->width = camera.width;
     image->height = camera.height;
     image->z.assign(static_cast<std::size_t>(camera.width) * camera.height, depth);
-    return DepthView{image, camera, std::nullopt, 0.0, nullptr};
+    return DepthView{image, camera, std::nullopt, 0.0, nullptr, nullptr};
   };
   // Oracle: a frame that measured 5 m everywhere saw through every place the
   // object could be in front of it (every pose is refuted); a frame without

@@ -12,6 +12,7 @@
 #include "c3po/base/random.hpp"
 #include "c3po/geometry/render.hpp"
 #include "c3po/geometry/scene_render.hpp"
+#include "c3po/io/segment.hpp"
 #include "c3po/io/support_plane.hpp"
 #include "c3po/method/free_space.hpp"
 #include "c3po/method/global_uniqueness.hpp"
@@ -242,7 +243,8 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   for (int v = 200; v < 280; ++v) {
     for (int u = 0; u < occluded->width; ++u) occluded->z[static_cast<std::size_t>(v) * occluded->width + u] = 0.5f;
   }
-  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera, std::nullopt, 0.0, nullptr}, options,
+  const FreeSpaceTest with_occluder(object, DepthView{occluded, frame.view.camera, std::nullopt, 0.0, nullptr, nullptr},
+                                    options,
                                     object.spec().eps_oc);
   const FreeSpace behind_occluder = with_occluder.Check(frame.truth);
   CHECK(behind_occluder.passed);
@@ -256,7 +258,7 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   // Missing depth is unknown, not a violation.
   auto holes = std::make_shared<DepthImage>(*frame.view.depth);
   std::fill(holes->z.begin(), holes->z.end(), 0.0f);
-  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera, std::nullopt, 0.0, nullptr}, options,
+  const FreeSpaceTest blind(object, DepthView{holes, frame.view.camera, std::nullopt, 0.0, nullptr, nullptr}, options,
                             object.spec().eps_oc);
   const FreeSpace unknown = blind.Check(shifted);
   CHECK(unknown.passed);
@@ -396,6 +398,99 @@ TEST_CASE("free space: two limits -- the estimate is judged at accept_fraction, 
 
 namespace {
 
+// The silhouette of `object` at `pose` as a mask, keeping the pixels with
+// column < `split` (all: split = the image width).
+Mask SilhouetteMask(const ObjectModel& object, const Pose& pose, int split) {
+  CameraIntrinsics camera;
+  DepthRenderer renderer(camera);
+  renderer.Render(object.mesh(), pose);
+  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+  Mask mask{camera.width, camera.height, std::vector<std::uint8_t>(pixels)};
+  for (const int pixel : renderer.covered_pixels()) {
+    mask.inside[static_cast<std::size_t>(pixel)] = pixel % camera.width < split;
+  }
+  return mask;
+}
+
+}  // namespace
+
+TEST_CASE("the mask: a pose claiming surface the mask gives to something else is refused; rivals are not judged by it") {
+  const ObjectModel object = BumpedBox();
+  Frame frame = RenderFrame(object);
+  const Mask whole = SilhouetteMask(object, frame.truth, frame.view.depth->width);
+  int left = frame.view.depth->width, right = 0;   // the silhouette's columns
+  for (int v = 0; v < whole.height; ++v) {
+    for (int u = 0; u < whole.width; ++u) {
+      if (whole.at(u, v)) left = std::min(left, u), right = std::max(right, u);
+    }
+  }
+  REQUIRE(right - left > 40);
+  const int split = (left + right) / 2;
+  FreeSpaceOptions options;
+  const int border = options.border_pixels;
+  const auto test_with = [&](const Mask& mask) {
+    DepthView view = frame.view;
+    view.mask = std::make_shared<const Mask>(mask);
+    return FreeSpaceTest(object, view, options, object.spec().eps_oc);
+  };
+
+  // The segmenter gave the silhouette's right half to a neighbour: the true
+  // pose claims that half's surface, which the camera sees at its depth.
+  const FreeSpaceTest half = test_with(SilhouetteMask(object, frame.truth, split));
+  const FreeSpace claimed = half.Check(frame.truth);
+  CHECK(claimed.mask_checked);
+  CHECK(claimed.silhouette_passed);
+  CHECK(claimed.violations == 0);
+  CHECK(claimed.seen_surface == claimed.measured);   // the frame is the render
+  // Oracle: brute-force bounds on the pixels counted more than `border`
+  // pixels from the mask (the best shift is 0 here): at most the
+  // silhouette's pixels right of the split, at least those that far right of
+  // it lying `border` deep inside the silhouette.
+  REQUIRE(claimed.shift_u == 0);
+  REQUIRE(claimed.shift_v == 0);
+  const Mask deep = ErodeMask(whole, border);
+  int upper = 0, lower = 0;
+  for (int v = 0; v < whole.height; ++v) {
+    for (int u = split; u < whole.width; ++u) {
+      upper += whole.at(u, v);
+      lower += u >= split + border && deep.at(u, v);
+    }
+  }
+  REQUIRE(lower > 0);
+  CHECK(claimed.seen_outside_mask >= lower);
+  CHECK(claimed.seen_outside_mask <= upper);
+  CHECK(claimed.seen_outside_mask > options.outside_mask_fraction * claimed.measured);
+  CHECK_FALSE(claimed.mask_passed);
+  CHECK_FALSE(claimed.passed);
+  CHECK(half.Passes(frame.truth, nullptr));   // as a rival it stands
+
+  // The whole silhouette, or a mask short of it by no more than the border: nothing claimed.
+  CHECK(test_with(whole).Check(frame.truth).seen_outside_mask == 0);
+  CHECK(test_with(whole).Check(frame.truth).passed);
+  const FreeSpace short_mask = test_with(ErodeMask(whole, border)).Check(frame.truth);
+  CHECK(short_mask.seen_outside_mask == 0);
+  CHECK(short_mask.passed);
+  // No mask, or the check off (fraction 1): not judged.
+  CHECK_FALSE(FreeSpaceTest(object, frame.view, options, object.spec().eps_oc).Check(frame.truth).mask_checked);
+  options.outside_mask_fraction = 1.0;
+  CHECK(test_with(SilhouetteMask(object, frame.truth, split)).Check(frame.truth).passed);
+  options.outside_mask_fraction = 1.5;
+  CHECK_THROWS_AS(options.Check(), std::invalid_argument);
+
+  // Through the pipeline: oc and nd pass, the mask refuses, the summary says why.
+  const PointSet cloud = frame.truth * SampleSurface(object.mesh(), 2000, 9);
+  const PoseEstimate e = EstimateAndCertify(object, cloud, frame.truth * object.keypoints(), Options(object), &half);
+  REQUIRE(e.ok());
+  CHECK(e.certificate.oc.passed);
+  CHECK(RefusedBy(e.certificate) == std::vector<CertificatePart>{CertificatePart::kMask});
+  const FreeSpace& f = e.certificate.free_space;
+  const std::string expected =
+      "mask: " + std::to_string(f.seen_outside_mask) + " of " + std::to_string(f.measured) + " measured pixels show";
+  CHECK(RefusalSummary(e.certificate).rfind(expected, 0) == 0);
+}
+
+namespace {
+
 // The object's points as the frame's camera sees them (DepthRenderer's
 // partial cloud: 3000 pixels, 1 mm noise along the ray), optionally without
 // the bump.
@@ -506,7 +601,8 @@ TEST_CASE("soundness on a table: the segmenter's plane filters rivals, yet no ce
     const SegmentCloud segment = ExtractSegment(depth, mask, camera, segment_options, "table scene");
     REQUIRE(segment.support_plane.has_value());
     if (segment.cloud.cols() < 200) continue;
-    const DepthView view{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance, nullptr};
+    const DepthView view{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance, nullptr,
+                         segment.mask};
     const FreeSpaceTest free_space(object, view, FreeSpaceOptions{}, object.spec().eps_oc);
     CHECK(free_space.Check(truth).through_support == 0);
     std::vector<PointSet> starts = {truth * object.keypoints()};
@@ -577,7 +673,7 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
   REQUIRE(fit.has_value());
   CHECK(fit->plane.normal.dot(table.normal) > 1.0 - 1e-6);   // oriented towards the camera
   CHECK(std::abs(fit->plane.offset - table.offset) < 1e-5);
-  DepthView view{depth, camera, fit->plane, distance, nullptr};
+  DepthView view{depth, camera, fit->plane, distance, nullptr, nullptr};
   const FreeSpaceOptions options;
   const FreeSpaceTest test(box, view, options, box.spec().eps_oc);
 
@@ -627,7 +723,7 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
   CHECK(test.Check(raised).through_support == 0);
 
   // Without the plane, nothing is claimed about the table.
-  DepthView no_plane{depth, camera, std::nullopt, 0.0, nullptr};
+  DepthView no_plane{depth, camera, std::nullopt, 0.0, nullptr, nullptr};
   const FreeSpaceTest without(box, no_plane, options, box.spec().eps_oc);
   const FreeSpace unchecked = without.Check(sunk);
   CHECK_FALSE(unchecked.support_checked);
@@ -641,7 +737,7 @@ TEST_CASE("support: a box resting on the table passes, sunk into it fails (count
     const long u = std::lround(uv.x()), v = std::lround(uv.y());
     if (u >= 0 && v >= 0 && u < camera.width && v < camera.height) blind->z[static_cast<std::size_t>(v) * camera.width + u] = 0.0f;
   }
-  const FreeSpaceTest blind_test(box, DepthView{blind, camera, fit->plane, distance, nullptr}, options,
+  const FreeSpaceTest blind_test(box, DepthView{blind, camera, fit->plane, distance, nullptr, nullptr}, options,
                                  box.spec().eps_oc);
   CHECK(blind_test.Check(sunk).through_support == 0);
 }

@@ -62,7 +62,8 @@ TEST_CASE("augmentation: copies drop the stated fraction, keep order, carry grou
   UnlabelledClouds data = Instances({1000, 37, 1, 2});
   // Each instance's depth frame (distinct images): every copy keeps its own.
   for (std::size_t i = 0; i < data.clouds.size(); ++i) {
-    data.frames.push_back(DepthView{std::make_shared<DepthImage>(), PinholeCamera{}, std::nullopt, 0.0, nullptr});
+    data.frames.push_back(
+        DepthView{std::make_shared<DepthImage>(), PinholeCamera{}, std::nullopt, 0.0, nullptr, nullptr});
   }
   AugmentOptions options;
   options.copies = 3;

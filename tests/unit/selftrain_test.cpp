@@ -125,7 +125,7 @@ TEST_CASE("camera frames: free space reaches the certificates of self-training, 
     image->width = camera.width;
     image->height = camera.height;
     image->z.assign(static_cast<std::size_t>(camera.width) * camera.height, depth);
-    return std::vector<DepthView>(clouds.size(), DepthView{image, camera, std::nullopt, 0.0, nullptr});
+    return std::vector<DepthView>(clouds.size(), DepthView{image, camera, std::nullopt, 0.0, nullptr, nullptr});
   };
   // Oracle: a frame that measured 5 m everywhere saw through every place the
   // object could be in front of it; a frame without depth knows nothing.

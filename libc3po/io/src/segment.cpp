@@ -52,6 +52,38 @@ Mask ErodeMask(const Mask& mask, int k) {
   return out;
 }
 
+std::vector<int> MaskDistance(const Mask& mask) {
+  // Two chamfer passes with unit steps to all 8 neighbours: exact for the
+  // chessboard metric.
+  const int w = mask.width, h = mask.height;
+  std::vector<int> d(mask.inside.size());
+  for (std::size_t i = 0; i < d.size(); ++i) d[i] = mask.inside[i] != 0 ? 0 : w + h;
+  const auto at = [&](int u, int v) -> int& { return d[static_cast<std::size_t>(v) * w + u]; };
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      int& x = at(u, v);
+      if (u > 0) x = std::min(x, at(u - 1, v) + 1);
+      if (v > 0) {
+        x = std::min(x, at(u, v - 1) + 1);
+        if (u > 0) x = std::min(x, at(u - 1, v - 1) + 1);
+        if (u + 1 < w) x = std::min(x, at(u + 1, v - 1) + 1);
+      }
+    }
+  }
+  for (int v = h - 1; v >= 0; --v) {
+    for (int u = w - 1; u >= 0; --u) {
+      int& x = at(u, v);
+      if (u + 1 < w) x = std::min(x, at(u + 1, v) + 1);
+      if (v + 1 < h) {
+        x = std::min(x, at(u, v + 1) + 1);
+        if (u + 1 < w) x = std::min(x, at(u + 1, v + 1) + 1);
+        if (u > 0) x = std::min(x, at(u - 1, v + 1) + 1);
+      }
+    }
+  }
+  return d;
+}
+
 void SegmentOptions::Check() const {
   if (erode_mask < 0 || erode_mask > 1000) throw std::invalid_argument("erode_mask must be in [0, 1000]");
   if (evidence_erode_mask < -1 || evidence_erode_mask > 1000) {
@@ -94,6 +126,7 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
   }
   SegmentCloud result;
   result.depth = std::make_shared<const DepthImage>(depth);
+  result.mask = std::make_shared<const Mask>(mask);
   result.camera = camera;
   const Mask eroded = ErodeMask(mask, options.erode_mask);
   const bool own_evidence = options.evidence_erode_mask >= 0 && options.evidence_erode_mask != options.erode_mask;

@@ -142,11 +142,13 @@ PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>*
   segment.evidence.reset();
   if (frame != nullptr) {
     frame->depth = segment.depth;
+    frame->mask = segment.mask;
     frame->camera = segment.camera;
     frame->support = segment.support_plane;
     frame->support_distance = segment.support_plane_distance;
   }
   segment.depth.reset();        // the counts never keep the image alive (~1 MB per instance)
+  segment.mask.reset();
   if (segment_counts != nullptr) *segment_counts = segment;
   segment.cloud = std::move(cloud);
   RequireUsableSegment(segment, source.name);   // throws the reason (the counts are already out)

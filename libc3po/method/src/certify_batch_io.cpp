@@ -138,14 +138,20 @@ void AddRivalKeys(const NonDegeneracy& nd, nlohmann::ordered_json* out) {
 // Free space (depth-image inputs, free_space.hpp); null when not checked.
 void AddFreeSpaceKeys(const FreeSpace& f, nlohmann::ordered_json* out) {
   nlohmann::ordered_json& line = *out;
-  line["free_space"] = f.checked ? nlohmann::ordered_json(f.passed) : nlohmann::ordered_json(nullptr);
+  const auto if_checked = [](bool checked, auto value) {
+    return checked ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
+  };
+  line["free_space"] = if_checked(f.checked, f.passed);
   line["free_space_violations"] = f.violations;
   line["free_space_measured"] = f.measured;
   line["free_space_silhouette"] = f.silhouette;
   line["free_space_tolerance"] = f.tolerance;
   line["free_space_limit"] = f.limit;
   line["free_space_shift_px"] = {f.shift_u, f.shift_v};
-  line["through_support"] = f.support_checked ? nlohmann::ordered_json(f.through_support) : nlohmann::ordered_json(nullptr);
+  line["through_support"] = if_checked(f.support_checked, f.through_support);
+  line["seen_surface"] = f.seen_surface;
+  line["seen_outside_mask"] = if_checked(f.mask_checked, f.seen_outside_mask);
+  line["outside_mask_limit"] = if_checked(f.mask_checked, f.mask_limit);
 }
 
 // Every key of an estimate, in the documented order.

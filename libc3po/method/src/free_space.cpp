@@ -18,6 +18,9 @@ void FreeSpaceOptions::Check() const {
   if (!(accept_fraction >= 0.0 && accept_fraction <= max_fraction)) {
     throw std::invalid_argument("free-space acceptance fraction must be in [0, the free-space fraction]");
   }
+  if (!(outside_mask_fraction >= 0.0 && outside_mask_fraction <= 1.0)) {
+    throw std::invalid_argument("outside-mask fraction must be in [0, 1]");
+  }
   if (border_pixels < 0 || border_pixels > 64) throw std::invalid_argument("free-space border must be in [0, 64] pixels");
 }
 
@@ -32,6 +35,11 @@ FreeSpaceTest::FreeSpaceTest(const ObjectModel& object, DepthView view, const Fr
     camera.height = view_.depth->height;
     renderer_ = std::make_unique<DepthRenderer>(camera);
   }
+  const bool mask_fits = view_.valid() && view_.mask && view_.mask->width == view_.depth->width &&
+                         view_.mask->height == view_.depth->height;
+  if (mask_fits) {
+    mask_distance_ = MaskDistance(*view_.mask);
+  }
 }
 
 namespace {
@@ -41,12 +49,14 @@ namespace {
 // samples at r and r/2 around it, plus the tolerance).
 struct CountedPixel {
   int u, v;
+  float z;      // the rendered depth
   float limit;
 };
 
 struct ShiftCount {
   int du = 0, dv = 0;
   int measured = 0, violations = 0;
+  int seen_surface = 0, seen_outside_mask = 0;
 };
 
 // Pixels spanned by `length` metres at depth z (focal f in pixels), at most
@@ -83,7 +93,7 @@ std::vector<CountedPixel> CountedPixels(const DepthRenderer& renderer, int w, in
         }
       }
     }
-    counted.push_back({u, v, static_cast<float>(farthest + tolerance)});
+    counted.push_back({u, v, static_cast<float>(z), static_cast<float>(farthest + tolerance)});
   }
   return counted;
 }
@@ -101,6 +111,21 @@ ShiftCount CountAtShift(const std::vector<CountedPixel>& counted, const DepthIma
     if (observed > p.limit) ++count.violations;
   }
   return count;
+}
+
+// At the shift: the measured pixels whose observation lies on the rendered
+// surface (within the tolerance in front, not behind the violation limit),
+// and of them those more than `border` pixels from the mask.
+void CountSeenOutsideMask(const std::vector<CountedPixel>& counted, const DepthImage& depth,
+                          const std::vector<int>& mask_distance, int border, double tolerance, ShiftCount* count) {
+  for (const CountedPixel& p : counted) {
+    const int u = p.u + count->du, v = p.v + count->dv;
+    if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) continue;
+    const float observed = depth.at(u, v);
+    if (!DepthImage::Valid(observed) || observed > p.limit || observed < p.z - tolerance) continue;
+    ++count->seen_surface;
+    count->seen_outside_mask += mask_distance[static_cast<std::size_t>(v) * depth.width + u] > border;
+  }
 }
 
 // Violations beyond the allowed fraction (<= 0 passes): what the shift search minimises.
@@ -128,7 +153,14 @@ int CountThroughSupport(const PointSet& sample, const Pose& camera_from_model, c
 }  // namespace
 
 FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
-  return Evaluate(camera_from_model, options_.accept_fraction);
+  FreeSpace result = Evaluate(camera_from_model, options_.accept_fraction);
+  if (!result.checked || mask_distance_.empty()) return result;
+  // The estimate only (free_space.hpp "The mask").
+  result.mask_checked = true;
+  result.mask_limit = options_.outside_mask_fraction;
+  result.mask_passed = !(result.seen_outside_mask > options_.outside_mask_fraction * result.measured);
+  result.passed = result.passed && result.mask_passed;
+  return result;
 }
 
 FreeSpace FreeSpaceTest::Evaluate(const Pose& camera_from_model, double limit) const {
@@ -193,6 +225,12 @@ FreeSpace FreeSpaceTest::CheckSilhouette(const Pose& camera_from_model, double l
       if (best.du == cu && best.dv == cv) break;
     }
   }
+  if (!mask_distance_.empty()) {
+    // At the best shift the silhouette is aligned with the frame already.
+    CountSeenOutsideMask(counted, depth, mask_distance_, options_.border_pixels, tolerance_, &best);
+  }
+  result.seen_surface = best.seen_surface;
+  result.seen_outside_mask = best.seen_outside_mask;
   result.measured = best.measured;
   result.violations = best.violations;
   result.shift_u = best.du;

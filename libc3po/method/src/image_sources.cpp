@@ -81,7 +81,8 @@ DatasetFrames BopDatasetFrames(std::shared_ptr<const BopInstances> listed, const
     // The segment is the dataset's cloud already; the frame and its support
     // plane come from the same extraction certify --bop makes.
     SegmentCloud segment = LoadBopInstance(it->second, options);
-    DepthView view{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance, nullptr};
+    DepthView view{segment.depth, segment.camera, segment.support_plane, segment.support_plane_distance, nullptr,
+                   segment.mask};
     if (segment.evidence) view.evidence = std::make_shared<const PointSet>(std::move(*segment.evidence));
     return view;
   };

@@ -41,6 +41,9 @@ std::string Evidence(CertificatePart part, const Certificate& c) {
                     f.violations, f.measured, f.tolerance, f.limit);
     case CertificatePart::kSupport:
       return Format("%d of %d model points below the table", f.through_support, f.support_points);
+    case CertificatePart::kMask:
+      return Format("%d of %d measured pixels show the posed surface outside the mask (limit %.3g)",
+                    f.seen_outside_mask, f.measured, f.mask_limit);
     case CertificatePart::kNdSets: {
       if (nd.set_min_support.empty()) return "no input points";
       const int best = *std::max_element(nd.set_min_support.begin(), nd.set_min_support.end());
@@ -71,6 +74,7 @@ const char* ToString(CertificatePart part) {
     case CertificatePart::kOcKeypoints: return "oc_keypoints";
     case CertificatePart::kFreeSpace: return "free_space";
     case CertificatePart::kSupport: return "support";
+    case CertificatePart::kMask: return "mask";
     case CertificatePart::kNdSets: return "nd_sets";
     case CertificatePart::kNdLocal: return "nd_local";
     case CertificatePart::kNdWeakMotion: return "nd_weak_motion";
@@ -85,6 +89,7 @@ std::vector<CertificatePart> RefusedBy(const Certificate& c) {
   if (!c.oc.keypoints_passed) parts.push_back(CertificatePart::kOcKeypoints);
   if (c.free_space.refutes() && !c.free_space.silhouette_passed) parts.push_back(CertificatePart::kFreeSpace);
   if (c.free_space.refutes() && !c.free_space.support_passed) parts.push_back(CertificatePart::kSupport);
+  if (c.free_space.refutes() && !c.free_space.mask_passed) parts.push_back(CertificatePart::kMask);
   const NonDegeneracy& nd = c.nd;
   if (!nd.sets_passed) parts.push_back(CertificatePart::kNdSets);
   if (LocalFailed(nd)) {

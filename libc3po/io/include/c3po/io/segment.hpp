@@ -47,6 +47,9 @@ struct Mask {
 Mask MaskFromImage(const Image& image, int label_id = -1);
 // Erodes by k pixels (see above); k = 0 returns the mask.
 Mask ErodeMask(const Mask& mask, int k);
+// Each pixel's chessboard (L∞) distance in pixels to the nearest mask pixel:
+// 0 inside; width + height when the mask is empty. Row-major like the mask.
+std::vector<int> MaskDistance(const Mask& mask);
 
 struct SegmentOptions {
   int erode_mask = 4;                      // pixels; 0 = off
@@ -73,6 +76,7 @@ struct SegmentCloud {
   // The frame it came from (the free-space test renders the posed model into
   // it, method/free_space.hpp); shared, released by the batch after use.
   std::shared_ptr<const DepthImage> depth;
+  std::shared_ptr<const Mask> mask;        // the segment's mask as given (not eroded)
   PinholeCamera camera;
   // The frame's support plane (step 4) when one was found, and its distance.
   std::optional<Plane> support_plane;
