@@ -185,6 +185,15 @@ TEST_CASE("global uniqueness: a symmetric object's turns are not rivals") {
 
 namespace {
 
+// oc passed, `part` alone refused the estimate, and the refusal's words
+// begin with `summary` followed by " measured pixels".
+void CheckRefusedOnlyBy(const PoseEstimate& e, CertificatePart part, const std::string& summary) {
+  REQUIRE(e.ok());
+  CHECK(e.certificate.oc.passed);
+  CHECK(RefusedBy(e.certificate) == std::vector<CertificatePart>{part});
+  CHECK(RefusalSummary(e.certificate).rfind(summary + " measured pixels", 0) == 0);
+}
+
 // A depth frame of the bumped box in front of a wall (the background) at the
 // true pose, rendered by the same renderer the test uses.
 struct Frame {
@@ -268,16 +277,12 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   // free space even though the given cloud (the object's points shifted) fits it.
   const PointSet cloud = shifted * SampleSurface(object.mesh(), 2000, 9);
   const PoseEstimate e = EstimateAndCertify(object, cloud, shifted * object.keypoints(), Options(object), &test);
-  REQUIRE(e.ok());
-  CHECK(e.certificate.oc.passed);
   CHECK(e.certificate.free_space.checked);
   CHECK_FALSE(e.certificate.free_space.passed);
   CHECK_FALSE(e.certified());
-  CHECK(RefusedBy(e.certificate) == std::vector<CertificatePart>{CertificatePart::kFreeSpace});
   const FreeSpace& f = e.certificate.free_space;
-  const std::string expected =
-      "free_space: " + std::to_string(f.violations) + " of " + std::to_string(f.measured) + " measured pixels";
-  CHECK(RefusalSummary(e.certificate).rfind(expected, 0) == 0);
+  CheckRefusedOnlyBy(e, CertificatePart::kFreeSpace,
+                     "free_space: " + std::to_string(f.violations) + " of " + std::to_string(f.measured));
 }
 
 namespace {
@@ -480,13 +485,9 @@ TEST_CASE("the mask: a pose claiming surface the mask gives to something else is
   // Through the pipeline: oc and nd pass, the mask refuses, the summary says why.
   const PointSet cloud = frame.truth * SampleSurface(object.mesh(), 2000, 9);
   const PoseEstimate e = EstimateAndCertify(object, cloud, frame.truth * object.keypoints(), Options(object), &half);
-  REQUIRE(e.ok());
-  CHECK(e.certificate.oc.passed);
-  CHECK(RefusedBy(e.certificate) == std::vector<CertificatePart>{CertificatePart::kMask});
   const FreeSpace& f = e.certificate.free_space;
-  const std::string expected =
-      "mask: " + std::to_string(f.seen_outside_mask) + " of " + std::to_string(f.measured) + " measured pixels show";
-  CHECK(RefusalSummary(e.certificate).rfind(expected, 0) == 0);
+  CheckRefusedOnlyBy(e, CertificatePart::kMask,
+                     "mask: " + std::to_string(f.seen_outside_mask) + " of " + std::to_string(f.measured));
 }
 
 namespace {
