@@ -419,7 +419,7 @@ Mask SilhouetteMask(const ObjectModel& object, const Pose& pose, int split) {
 
 }  // namespace
 
-TEST_CASE("the mask: a pose claiming surface the mask gives to something else is refused; rivals are not judged by it") {
+TEST_CASE("the mask: a pose claiming surface the mask gives to something else is refused, and rivals are not judged by it") {
   const ObjectModel object = BumpedBox();
   Frame frame = RenderFrame(object);
   const Mask whole = SilhouetteMask(object, frame.truth, frame.view.depth->width);
