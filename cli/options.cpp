@@ -105,6 +105,9 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_option("--outside-mask-fraction", flags->outside_mask,
                      "Depth-image inputs: the estimate is certified only if at most this fraction of its measured "
                      "silhouette pixels show its surface outside the segment's mask (default 0.05; 1 = off)");
+  command.add_option("--uncovered-mask-fraction", flags->uncovered_mask,
+                     "Depth-image inputs: the estimate is certified only if at most this fraction of the mask's "
+                     "pixels at its depth lie outside its silhouette (default 0.035; 1 = off)");
 }
 
 namespace {
@@ -138,6 +141,9 @@ void ResolveFreeSpaceLimits(const RobustFlags& flags, FreeSpaceOptions* options)
   }
   if (!flags.outside_mask.empty()) {
     options->outside_mask_fraction = ParseFraction(flags.outside_mask, "--outside-mask-fraction", true);
+  }
+  if (!flags.uncovered_mask.empty()) {
+    options->uncovered_mask_fraction = ParseFraction(flags.uncovered_mask, "--uncovered-mask-fraction", true);
   }
 }
 
@@ -219,6 +225,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;
   if (!flags.free_space_accept.empty()) line += " --free-space-accept " + flags.free_space_accept;
   if (!flags.outside_mask.empty()) line += " --outside-mask-fraction " + flags.outside_mask;
+  if (!flags.uncovered_mask.empty()) line += " --uncovered-mask-fraction " + flags.uncovered_mask;
   return line;
 }
 

@@ -86,6 +86,7 @@ struct RobustFlags {
   std::string free_space_fraction; // --free-space-fraction ("" = default)
   std::string free_space_accept;   // --free-space-accept ("" = default, at most the fraction)
   std::string outside_mask;        // --outside-mask-fraction ("" = default)
+  std::string uncovered_mask;      // --uncovered-mask-fraction ("" = default)
 };
 void AddRobustOptions(CLI::App& command, RobustFlags* flags);
 // What the clouds of a run are; where --max-outliers / --robust-loss are not

@@ -20,7 +20,8 @@ for c in "${commands[@]}"; do
   # shellcheck disable=SC2086
   "$C3PO" $c --help > "help.txt" 2>&1 || fail "$c --help exited $?"
   for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue --no-global-check \
-      --global-steps --no-free-space --free-space-fraction --free-space-accept --outside-mask-fraction; do
+      --global-steps --no-free-space --free-space-fraction --free-space-accept --outside-mask-fraction \
+      --uncovered-mask-fraction; do
     grep -q -- "$flag" help.txt || fail "$c --help lacks $flag"
   done
   grep -q "allow_extra_args\|->" help.txt && fail "$c --help shows code: $(grep 'allow_extra_args\|->' help.txt)"
@@ -167,23 +168,33 @@ bad_value --free-space-accept "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --d
 bad_value --free-space-accept "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --free-space-fraction 0.01 \
   --free-space-accept 0.02
 bad_value --free-space-accept "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --free-space-accept abc
-# The mask test (--outside-mask-fraction, default 0.05): the JSON carries the
-# limit applied and the counts; 1 switches it off; beyond [0, 1] is an error.
-mask_limit() { python3 -c "import json,sys; print(sorted({json.loads(l)['outside_mask_limit'] for l in open(sys.argv[1])}))" "$1"; }
-"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
-[ "$(mask_limit c.jsonl)" == "[0.05]" ] || fail "certify --bop outside-mask limit: $(mask_limit c.jsonl)"
-python3 -c "
+# The mask tests: mask_option FLAG LIMIT_KEY DEFAULT PART COUNT TOTAL: the
+# JSON carries the limit applied and the counts (0 <= COUNT <= TOTAL), PART
+# refuses exactly when COUNT > DEFAULT * TOTAL; 1 switches it off; beyond
+# [0, 1] is an error.
+mask_option() {
+  local flag=$1 key=$2 default=$3 part=$4 count=$5 total=$6 limit
+  limit_of() { python3 -c "import json,sys; print(sorted({json.loads(l)[sys.argv[2]] for l in open(sys.argv[1])}))" "$1" "$key"; }
+  "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
+  limit=$(limit_of c.jsonl)
+  [ "$limit" == "[$default]" ] || fail "certify --bop $key: $limit"
+  python3 -c "
 import json,sys
+count, total, part, default = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
 for l in open('c.jsonl'):
     j = json.loads(l)
-    assert 0 <= j['seen_outside_mask'] <= j['seen_surface'] <= j['free_space_measured'], j['cloud']
-    assert ('mask' in j['refused_by']) == (j['seen_outside_mask'] > 0.05 * j['free_space_measured']), j['cloud']
-" || fail "certify --bop: mask counts or refusals inconsistent"
-"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --outside-mask-fraction 1 -o c.jsonl > c.out 2>&1 || true
-[ "$(mask_limit c.jsonl)" == "[1.0]" ] || fail "--outside-mask-fraction 1: limit $(mask_limit c.jsonl)"
-grep -q '"mask"' c.jsonl && fail "--outside-mask-fraction 1 still refuses by the mask"
-bad_value --outside-mask-fraction "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --outside-mask-fraction 1.5
-bad_value --outside-mask-fraction "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --outside-mask-fraction x
+    assert 0 <= j[count] <= j[total], j['cloud']
+    assert (part in j['refused_by']) == (j[count] > default * j[total]), j['cloud']
+" "$count" "$total" "$part" "$default" || fail "certify --bop: $count or '$part' refusals inconsistent"
+  "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd "$flag" 1 -o c.jsonl > c.out 2>&1 || true
+  limit=$(limit_of c.jsonl)
+  [ "$limit" == "[1.0]" ] || fail "$flag 1: limit $limit"
+  grep -q "\"$part\"" c.jsonl && fail "$flag 1 still refuses by '$part'"
+  bad_value "$flag" "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd "$flag" 1.5
+  bad_value "$flag" "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd "$flag" x
+}
+mask_option --outside-mask-fraction outside_mask_limit 0.05 mask seen_outside_mask free_space_measured
+mask_option --uncovered-mask-fraction uncovered_mask_limit 0.035 uncovered mask_uncovered mask_at_depth
 if [ $pointnet -eq 1 ]; then
   "$C3PO" selftrain "$NOSETS" --model cube.model --bop bop --obj-id 3 --copies 2 --epochs 1 -o self_bop.model     > s.out 2>&1 || fail "selftrain --bop exited $?: $(tail -1 s.out)"
   [ "$(summary s.out)" == "m = 2%, robust loss = tls" ] || fail "selftrain --bop defaults: '$(summary s.out)'"

@@ -83,6 +83,7 @@ for bad in nan -0.5 1 abc; do
 done
 for bad in nan -0.5 1.5 abc; do
   check "outside_mask_${bad}" "2" - --outside-mask-fraction one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --outside-mask-fraction "$bad" one_point.xyz
+  check "uncovered_mask_${bad}" "2" - --uncovered-mask-fraction one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --uncovered-mask-fraction "$bad" one_point.xyz
 done
 for bad in -1 abc 1.5 2000; do
   check "evidence_erode_mask_${bad}" "2" - --evidence-erode-mask one_point.xyz -- "$C3PO" certify "$CUBE" --detector svd --evidence-erode-mask "$bad" one_point.xyz

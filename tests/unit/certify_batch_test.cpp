@@ -357,7 +357,8 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "free_space_violations", "free_space_measured",
                                          "free_space_silhouette", "free_space_tolerance", "free_space_limit",
                                          "free_space_shift_px", "through_support", "seen_surface",
-                                         "seen_outside_mask", "outside_mask_limit", "ms"});
+                                         "seen_outside_mask", "outside_mask_limit", "mask_at_depth", "mask_uncovered",
+                                         "uncovered_mask_limit", "ms"});
   CHECK(j["cloud"] == "a.ply");
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) CHECK(j["R"][r][c].get<double>() == e.scene_from_model.R(r, c));

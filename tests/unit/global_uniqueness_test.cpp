@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
+#include <utility>
 
 #include "c3po/base/random.hpp"
 #include "c3po/geometry/render.hpp"
@@ -186,12 +188,21 @@ TEST_CASE("global uniqueness: a symmetric object's turns are not rivals") {
 namespace {
 
 // oc passed, `part` alone refused the estimate, and the refusal's words
-// begin with `summary` followed by " measured pixels".
+// begin with `summary`.
 void CheckRefusedOnlyBy(const PoseEstimate& e, CertificatePart part, const std::string& summary) {
   REQUIRE(e.ok());
   CHECK(e.certificate.oc.passed);
   CHECK(RefusedBy(e.certificate) == std::vector<CertificatePart>{part});
-  CHECK(RefusalSummary(e.certificate).rfind(summary + " measured pixels", 0) == 0);
+  CHECK(RefusalSummary(e.certificate).rfind(summary, 0) == 0);
+}
+
+// The object's own surface at the truth through the pipeline with `test`:
+// `part` alone refuses, and the summary begins with `summary(free space)`.
+void CheckPipelineRefusedOnlyBy(const ObjectModel& object, const Pose& truth, const FreeSpaceTest& test,
+                                CertificatePart part, const std::function<std::string(const FreeSpace&)>& summary) {
+  const PointSet cloud = truth * SampleSurface(object.mesh(), 2000, 9);
+  const PoseEstimate e = EstimateAndCertify(object, cloud, truth * object.keypoints(), Options(object), &test);
+  CheckRefusedOnlyBy(e, part, summary(e.certificate.free_space));
 }
 
 // A depth frame of the bumped box in front of a wall (the background) at the
@@ -282,7 +293,8 @@ TEST_CASE("free space: the true pose passes, a pose whose silhouette covers the 
   CHECK_FALSE(e.certified());
   const FreeSpace& f = e.certificate.free_space;
   CheckRefusedOnlyBy(e, CertificatePart::kFreeSpace,
-                     "free_space: " + std::to_string(f.violations) + " of " + std::to_string(f.measured));
+                     "free_space: " + std::to_string(f.violations) + " of " + std::to_string(f.measured) +
+                         " measured pixels");
 }
 
 namespace {
@@ -483,11 +495,99 @@ TEST_CASE("the mask: a pose claiming surface the mask gives to something else is
   CHECK_THROWS_AS(options.Check(), std::invalid_argument);
 
   // Through the pipeline: oc and nd pass, the mask refuses, the summary says why.
-  const PointSet cloud = frame.truth * SampleSurface(object.mesh(), 2000, 9);
-  const PoseEstimate e = EstimateAndCertify(object, cloud, frame.truth * object.keypoints(), Options(object), &half);
-  const FreeSpace& f = e.certificate.free_space;
-  CheckRefusedOnlyBy(e, CertificatePart::kMask,
-                     "mask: " + std::to_string(f.seen_outside_mask) + " of " + std::to_string(f.measured));
+  CheckPipelineRefusedOnlyBy(object, frame.truth, half, CertificatePart::kMask, [](const FreeSpace& f) {
+    return "mask: " + std::to_string(f.seen_outside_mask) + " of " + std::to_string(f.measured) + " measured pixels";
+  });
+}
+
+namespace {
+
+// Oracle for the uncovered count: the mask's pixels whose observed depth lies
+// within the depth range of `object`'s render at `pose` (± tolerance), and
+// of them those with no rendered pixel in the (2·border + 1)² window around
+// them (brute force, no distance transform).
+std::pair<int, int> UncoveredByBruteForce(const ObjectModel& object, const Pose& pose, const Mask& mask,
+                                          const DepthImage& depth, int border, double tolerance) {
+  CameraIntrinsics camera;
+  DepthRenderer renderer(camera);
+  renderer.Render(object.mesh(), pose);
+  double nearest = 1e9, farthest = 0.0;
+  for (const int pixel : renderer.covered_pixels()) {
+    nearest = std::min(nearest, renderer.DepthAt(pixel % camera.width, pixel / camera.width));
+    farthest = std::max(farthest, renderer.DepthAt(pixel % camera.width, pixel / camera.width));
+  }
+  int at_depth = 0, uncovered = 0;
+  for (int v = 0; v < mask.height; ++v) {
+    for (int u = 0; u < mask.width; ++u) {
+      const float z = depth.at(u, v);
+      if (!mask.at(u, v) || !DepthImage::Valid(z) || z < nearest - tolerance || z > farthest + tolerance) continue;
+      ++at_depth;
+      bool covered = false;
+      for (int dv = -border; dv <= border; ++dv) {
+        for (int du = -border; du <= border; ++du) {
+          const int x = u + du, y = v + dv;
+          covered = covered || (x >= 0 && y >= 0 && x < mask.width && y < mask.height && renderer.TriangleAt(x, y) >= 0);
+        }
+      }
+      uncovered += !covered;
+    }
+  }
+  return {at_depth, uncovered};
+}
+
+}  // namespace
+
+TEST_CASE("the mask's uncovered pixels: a pose that explains only part of the segment is refused, and rivals are not judged by it") {
+  const ObjectModel object = BumpedBox();
+  // The segmented object: the bumped box with 3 cm of the same section glued to its +x end.
+  ObjectModelOptions longer_options;
+  longer_options.sample_size = 20000;
+  const ObjectModel longer(object.spec(), test::MergeMeshes({BumpedBoxMesh(),
+                                                             test::BoxMesh({0.115, 0.0, 0.0}, {0.03, 0.10, 0.06})}),
+                           longer_options);
+  Frame frame = RenderFrame(longer);
+  FreeSpaceOptions options;
+  const auto test_with = [&](const Frame& f, const Mask& mask) {
+    DepthView view = f.view;
+    view.mask = std::make_shared<const Mask>(mask);
+    return FreeSpaceTest(object, view, options, object.spec().eps_oc);
+  };
+  const Mask segment = SilhouetteMask(longer, frame.truth, frame.view.depth->width);
+  const FreeSpaceTest test = test_with(frame, segment);
+  const FreeSpace part = test.Check(frame.truth);
+  CHECK(part.mask_checked);
+  CHECK(part.silhouette_passed);      // nothing seen through: the extension is in front of or at the model
+  CHECK(part.mask_passed);            // and the model claims nothing outside the mask
+  REQUIRE(part.shift_u == 0);
+  REQUIRE(part.shift_v == 0);
+  const auto [at_depth, uncovered] =
+      UncoveredByBruteForce(object, frame.truth, segment, *frame.view.depth, options.border_pixels, part.tolerance);
+  REQUIRE(uncovered > 0);
+  CHECK(part.mask_at_depth == at_depth);
+  CHECK(part.mask_uncovered == uncovered);
+  CHECK(part.uncovered_limit == options.uncovered_mask_fraction);
+  CHECK(part.mask_uncovered > options.uncovered_mask_fraction * part.mask_at_depth);
+  CHECK_FALSE(part.uncovered_passed);
+  CHECK_FALSE(part.passed);
+  CHECK(test.Passes(frame.truth, nullptr));   // as a rival it stands
+
+  // The object's own frame and mask: nothing uncovered.
+  const Frame own = RenderFrame(object);
+  const FreeSpace whole = test_with(own, SilhouetteMask(object, own.truth, own.view.depth->width)).Check(own.truth);
+  CHECK(whole.mask_at_depth > 0);
+  CHECK(whole.mask_uncovered == 0);
+  CHECK(whole.passed);
+  // Off (fraction 1); out of range.
+  options.uncovered_mask_fraction = 1.0;
+  CHECK(test_with(frame, segment).Check(frame.truth).passed);
+  options.uncovered_mask_fraction = 1.5;
+  CHECK_THROWS_AS(options.Check(), std::invalid_argument);
+
+  // Through the pipeline: the cloud is the bumped box's (oc and nd pass), the uncovered pixels refuse.
+  CheckPipelineRefusedOnlyBy(object, frame.truth, test, CertificatePart::kUncovered, [](const FreeSpace& f) {
+    return "uncovered: " + std::to_string(f.mask_uncovered) + " of " + std::to_string(f.mask_at_depth) +
+           " mask pixels";
+  });
 }
 
 namespace {

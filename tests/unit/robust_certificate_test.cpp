@@ -290,8 +290,8 @@ TEST_CASE("refusal: every failed part is named with its evidence, nothing when c
   }
   std::vector<std::string> names;   // distinct names for every part
   for (std::size_t k = 0; k < kCertificatePartCount; ++k) names.push_back(ToString(static_cast<CertificatePart>(k)));
-  CHECK(names == std::vector<std::string>{"oc", "oc_keypoints", "free_space", "support", "mask", "nd_sets",
-                                          "nd_local", "nd_weak_motion", "nd_global"});
+  CHECK(names == std::vector<std::string>{"oc", "oc_keypoints", "free_space", "support", "mask", "uncovered",
+                                          "nd_sets", "nd_local", "nd_weak_motion", "nd_global"});
 }
 
 TEST_CASE("local non-degeneracy: a box seen face-on fails, a corner view passes") {

@@ -152,6 +152,9 @@ void AddFreeSpaceKeys(const FreeSpace& f, nlohmann::ordered_json* out) {
   line["seen_surface"] = f.seen_surface;
   line["seen_outside_mask"] = if_checked(f.mask_checked, f.seen_outside_mask);
   line["outside_mask_limit"] = if_checked(f.mask_checked, f.mask_limit);
+  line["mask_at_depth"] = if_checked(f.mask_checked, f.mask_at_depth);
+  line["mask_uncovered"] = if_checked(f.mask_checked, f.mask_uncovered);
+  line["uncovered_mask_limit"] = if_checked(f.mask_checked, f.uncovered_limit);
 }
 
 // Every key of an estimate, in the documented order.

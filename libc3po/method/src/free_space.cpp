@@ -21,6 +21,9 @@ void FreeSpaceOptions::Check() const {
   if (!(outside_mask_fraction >= 0.0 && outside_mask_fraction <= 1.0)) {
     throw std::invalid_argument("outside-mask fraction must be in [0, 1]");
   }
+  if (!(uncovered_mask_fraction >= 0.0 && uncovered_mask_fraction <= 1.0)) {
+    throw std::invalid_argument("uncovered-mask fraction must be in [0, 1]");
+  }
   if (border_pixels < 0 || border_pixels > 64) throw std::invalid_argument("free-space border must be in [0, 64] pixels");
 }
 
@@ -128,6 +131,42 @@ void CountSeenOutsideMask(const std::vector<CountedPixel>& counted, const DepthI
   }
 }
 
+// The rendered silhouette as a mask, and the depth range it spans.
+Mask RenderedSilhouette(const DepthRenderer& renderer, int w, int h, double* nearest, double* farthest) {
+  Mask silhouette{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h)};
+  *nearest = std::numeric_limits<double>::infinity();
+  *farthest = 0.0;
+  for (const int pixel : renderer.covered_pixels()) {
+    silhouette.inside[static_cast<std::size_t>(pixel)] = 1;
+    const double z = renderer.DepthAt(pixel % w, pixel / w);
+    *nearest = std::min(*nearest, z);
+    *farthest = std::max(*farthest, z);
+  }
+  return silhouette;
+}
+
+// The mask's pixels whose observed depth lies within the rendered depth
+// range ± tolerance (`at_depth`) and, of them, those more than `border`
+// pixels from the silhouette moved by the shift (`uncovered`).
+void CountUncoveredMask(const DepthRenderer& renderer, const Mask& mask, const DepthImage& depth, int du, int dv,
+                        int border, double tolerance, int* at_depth, int* uncovered) {
+  double nearest = 0.0, farthest = 0.0;
+  const std::vector<int> distance =
+      MaskDistance(RenderedSilhouette(renderer, depth.width, depth.height, &nearest, &farthest));
+  *at_depth = *uncovered = 0;
+  for (int v = 0; v < depth.height; ++v) {
+    for (int u = 0; u < depth.width; ++u) {
+      const float observed = depth.at(u, v);
+      if (!mask.at(u, v) || !DepthImage::Valid(observed)) continue;
+      if (observed < nearest - tolerance || observed > farthest + tolerance) continue;
+      ++*at_depth;
+      const int su = u - du, sv = v - dv;   // where the shifted silhouette's pixel came from
+      const bool inside = su >= 0 && sv >= 0 && su < depth.width && sv < depth.height;
+      *uncovered += !inside || distance[static_cast<std::size_t>(sv) * depth.width + su] > border;
+    }
+  }
+}
+
 // Violations beyond the allowed fraction (<= 0 passes): what the shift search minimises.
 double Excess(const ShiftCount& c, double fraction) { return c.violations - fraction * c.measured; }
 
@@ -159,7 +198,13 @@ FreeSpace FreeSpaceTest::Check(const Pose& camera_from_model) const {
   result.mask_checked = true;
   result.mask_limit = options_.outside_mask_fraction;
   result.mask_passed = !(result.seen_outside_mask > options_.outside_mask_fraction * result.measured);
-  result.passed = result.passed && result.mask_passed;
+  // The converse: the mask's surface the pose does not cover (free_space.hpp).
+  renderer_->Render(object_.mesh(), camera_from_model);
+  CountUncoveredMask(*renderer_, *view_.mask, *view_.depth, result.shift_u, result.shift_v, options_.border_pixels,
+                     tolerance_, &result.mask_at_depth, &result.mask_uncovered);
+  result.uncovered_limit = options_.uncovered_mask_fraction;
+  result.uncovered_passed = !(result.mask_uncovered > options_.uncovered_mask_fraction * result.mask_at_depth);
+  result.passed = result.passed && result.mask_passed && result.uncovered_passed;
   return result;
 }
 

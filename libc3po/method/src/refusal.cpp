@@ -44,6 +44,9 @@ std::string Evidence(CertificatePart part, const Certificate& c) {
     case CertificatePart::kMask:
       return Format("%d of %d measured pixels show the posed surface outside the mask (limit %.3g)",
                     f.seen_outside_mask, f.measured, f.mask_limit);
+    case CertificatePart::kUncovered:
+      return Format("%d of %d mask pixels at the posed model's depth lie outside its silhouette (limit %.3g)",
+                    f.mask_uncovered, f.mask_at_depth, f.uncovered_limit);
     case CertificatePart::kNdSets: {
       if (nd.set_min_support.empty()) return "no input points";
       const int best = *std::max_element(nd.set_min_support.begin(), nd.set_min_support.end());
@@ -75,6 +78,7 @@ const char* ToString(CertificatePart part) {
     case CertificatePart::kFreeSpace: return "free_space";
     case CertificatePart::kSupport: return "support";
     case CertificatePart::kMask: return "mask";
+    case CertificatePart::kUncovered: return "uncovered";
     case CertificatePart::kNdSets: return "nd_sets";
     case CertificatePart::kNdLocal: return "nd_local";
     case CertificatePart::kNdWeakMotion: return "nd_weak_motion";
@@ -90,6 +94,7 @@ std::vector<CertificatePart> RefusedBy(const Certificate& c) {
   if (c.free_space.refutes() && !c.free_space.silhouette_passed) parts.push_back(CertificatePart::kFreeSpace);
   if (c.free_space.refutes() && !c.free_space.support_passed) parts.push_back(CertificatePart::kSupport);
   if (c.free_space.refutes() && !c.free_space.mask_passed) parts.push_back(CertificatePart::kMask);
+  if (c.free_space.refutes() && !c.free_space.uncovered_passed) parts.push_back(CertificatePart::kUncovered);
   const NonDegeneracy& nd = c.nd;
   if (!nd.sets_passed) parts.push_back(CertificatePart::kNdSets);
   if (LocalFailed(nd)) {

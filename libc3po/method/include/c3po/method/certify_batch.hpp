@@ -143,7 +143,7 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 // "Output schemas"): one object per cloud, keys in this order:
 //   cloud, R (3 rows), t, keypoints (N x 3, corrected), oc, nd, certified,
 //   refused_by (the failed parts, refusal.hpp: "oc", "oc_keypoints",
-//   "free_space", "support", "mask", "nd_sets", "nd_local", "nd_weak_motion",
+//   "free_space", "support", "mask", "uncovered", "nd_sets", "nd_local", "nd_weak_motion",
 //   "nd_global"; [] when certified, ["registration"] without a pose),
 //   oc_distance (null when not finite), keypoint_distance, nd_set,
 //   nd_set_distances, eps_oc, delta_nd, iterations, cost_before, cost_after
@@ -172,8 +172,9 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   free_space_violations, free_space_measured, free_space_silhouette,
 //   free_space_tolerance, free_space_limit, free_space_shift_px,
 //   through_support (null without a support plane), seen_surface,
-//   seen_outside_mask and outside_mask_limit (null without a mask; the mask
-//   test, free_space.hpp); and last ms. Image-source lines also carry
+//   seen_outside_mask, outside_mask_limit, mask_at_depth, mask_uncovered and
+//   uncovered_mask_limit (null without a mask; the mask tests,
+//   free_space.hpp); and last ms. Image-source lines also carry
 //   gt_hausdorff after gt_t (Hausdorff(T*·B̂, T̂·B̂), metres) when the
 //   ground truth is known.
 constexpr std::size_t kMaxListedOutliers = 100;

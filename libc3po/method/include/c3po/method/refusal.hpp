@@ -20,6 +20,7 @@ enum class CertificatePart {
   kFreeSpace,      // depth-image inputs: the camera saw through the posed model
   kSupport,        // depth-image inputs: the posed model reaches into the table
   kMask,           // depth-image inputs: the posed model claims surface seen outside the segment's mask
+  kUncovered,      // depth-image inputs: the mask shows surface at the model's depth the posed model does not cover
   kNdSets,         // no indicator set is supported
   kNdLocal,        // a motion the accepted points do not constrain (first order)
   kNdWeakMotion,   // the single unseen motion leads to a pose that fits too
@@ -27,7 +28,7 @@ enum class CertificatePart {
 };
 inline constexpr std::size_t kCertificatePartCount = static_cast<std::size_t>(CertificatePart::kNdGlobal) + 1;
 
-// "oc", "oc_keypoints", "free_space", "support", "mask", "nd_sets", "nd_local",
+// "oc", "oc_keypoints", "free_space", "support", "mask", "uncovered", "nd_sets", "nd_local",
 // "nd_weak_motion", "nd_global".
 const char* ToString(CertificatePart part);
 
