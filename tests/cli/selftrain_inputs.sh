@@ -23,7 +23,9 @@ source "$(dirname "$0")/lib.sh"
   || { echo "train failed"; exit 1; }
 
 # A loose eps_oc certifies every instance: the mechanics, not the quality, are tested here.
-"$C3PO" selftrain "$MUG" --model mug.model --bop bop --obj-id 4 --copies 3 --epochs 1 --eps-oc 60%d \
+# The uncovered-mask test judges the pose whatever eps_oc is (the 1-epoch detector's
+# poses are 3.5-10 cm off and leave 10-100 % of the mask unexplained): off here too.
+"$C3PO" selftrain "$MUG" --model mug.model --bop bop --obj-id 4 --copies 3 --epochs 1 --eps-oc 60%d --uncovered-mask-fraction 1 \
   --val-fraction 0.25 --seed 1 -o self.model > self.out 2> self.err \
   || fail "selftrain --bop exited $?: $(tail -2 self.err)"
 grep -q "4 real instances (0 skipped) -> 12 augmented clouds (3 copies, dropout 0.1, noise 0.001)" self.err \
@@ -33,7 +35,7 @@ grep -q "self-training on 12 unlabelled clouds" self.err || fail "selftrain --bo
 # Ground truth of the BOP instances is reported (never used): the log has the truth columns.
 grep -q "validation_hausdorff_median" self.model.log.jsonl || fail "no ground-truth reporting columns in the log"
 # Same seed, same model bytes.
-"$C3PO" selftrain "$MUG" --model mug.model --bop bop --obj-id 4 --copies 3 --epochs 1 --eps-oc 60%d \
+"$C3PO" selftrain "$MUG" --model mug.model --bop bop --obj-id 4 --copies 3 --epochs 1 --eps-oc 60%d --uncovered-mask-fraction 1 \
   --val-fraction 0.25 --seed 1 -o self2.model > /dev/null 2>&1 || fail "second selftrain --bop"
 cmp -s self.model self2.model || fail "selftrain --bop is not deterministic"
 
@@ -59,7 +61,7 @@ expect_error add_no_bop "--add-obj-id needs --bop" --data no_such_dir --add-obj-
 "$C3PO" synth "$MUG" -o bopmix --format bop --count 4 --obj-id 4 --distractors 1 --distractor "$BOX:6" \
   --intrinsics 400,400,159.5,119.5,320,240 --seed 3 > synthmix.log 2>&1 || fail "synth bopmix: $(tail -2 synthmix.log)"
 "$C3PO" selftrain "$MUG" --model mug.model --bop bopmix --obj-id 4 --add-obj-id 6 --copies 2 --epochs 1 \
-  --eps-oc 60%d --val-fraction 0.25 --seed 1 -o mixbop.model > mixbop.out 2> mixbop.err
+  --eps-oc 60%d --uncovered-mask-fraction 1 --val-fraction 0.25 --seed 1 -o mixbop.model > mixbop.out 2> mixbop.err
 status=$?
 if [ $status -eq 0 ]; then
   grep -q "self-training on 16 unlabelled clouds" mixbop.err || fail "--add-obj-id: not 16 clouds: $(head -3 mixbop.err)"
