@@ -43,7 +43,7 @@
 // but more than border_pixels from its silhouette (at the best shift) is
 // surface the segmenter gave to the object that the pose does not explain.
 // A model smaller than the segmented object fits its points within ε_oc
-// where the difference is under ε_oc (a cracker box posed on a box 2 cm
+// where the difference is under ε_oc (a cracker box posed on a box up to 8 mm
 // longer); the estimate is refused when more than `uncovered_mask_fraction`
 // of those mask pixels are uncovered. Refusing only, the estimate only, as
 // for the mask above.
@@ -89,7 +89,7 @@ struct FreeSpaceOptions {
   // border_pixels outside its silhouette; the estimate only. Measured
   // (docs/method.md "The mask's uncovered pixels"): certified correct real
   // estimates <= 2.7 %, the real ground truth <= 4.1 %; a cracker box certified
-  // on the segments of a box 2 cm longer 3.6-7.0 %.
+  // on the segments of a box up to 8 mm larger per side 3.6-7.0 %.
   double uncovered_mask_fraction = 0.035;
   int border_pixels = 3;       // plus f·tolerance/z: pixels this close to a rendered edge are not counted
   void Check() const;          // throws std::invalid_argument
