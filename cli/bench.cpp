@@ -89,7 +89,7 @@ CorrectorBenchmarkOptions CorrectorBenchOptions(const CorrectorBenchCommand& cmd
   for (std::string name; std::getline(solver_list, name, ',');) options.solvers.push_back(ParseCorrectorSolver(name));
   options.corrector.loss = ParsePointCloudLoss(cmd.corrector.loss);
   options.certificate = ResolveThresholds(cmd.thresholds, object);
-  ResolveRobust(cmd.robust, InputKind::kClouds, object.spec(), &options.certificate, &options.corrector);
+  ResolveRobust(cmd.robust, InputKind::kClouds, object, &options.certificate, &options.corrector);
   {
     const OutlierBudget stray = ParseOutlierBudget(cmd.stray);   // the same "P%" syntax
     if (stray.count > 0) throw InputError("--stray", "give a percentage of each cloud's points (5%)");

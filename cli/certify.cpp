@@ -285,7 +285,7 @@ CertifyBatchOptions CertifyOptions(const CertifyCommand& cmd, const ObjectModel&
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
   options.pipeline.certificate = ResolveThresholds(cmd.thresholds, object);
   const InputKind input = CameraInput(cmd) ? InputKind::kCameraFrames : InputKind::kClouds;
-  ResolveRobust(cmd.robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
+  ResolveRobust(cmd.robust, input, object, &options.pipeline.certificate, &options.pipeline.corrector);
   options.auto_eps_oc = cmd.thresholds.auto_eps_oc();
   if (options.auto_eps_oc && !cmd.shard.empty()) {
     throw InputError("--eps-oc", "auto estimates the threshold from all clouds of a run; with --shard give a value");

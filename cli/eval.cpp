@@ -141,7 +141,7 @@ EvaluationOptions MakeOptions(const EvalCommand& cmd, const ObjectModel& object,
     throw InputError(cmd.object_path, "the object has no eps_oc / delta_nd: give --eps-oc and --delta-nd");
   }
   ResolveCorrector(cmd.corrector, &options.pipeline.corrector);
-  ResolveRobust(cmd.robust, cmd.bop.dir.empty() ? InputKind::kClouds : InputKind::kCameraFrames, object.spec(),
+  ResolveRobust(cmd.robust, cmd.bop.dir.empty() ? InputKind::kClouds : InputKind::kCameraFrames, object,
                 &options.pipeline.certificate, &options.pipeline.corrector);
   options.run_icp = !cmd.no_icp;
   options.run_ransac = !cmd.no_ransac;

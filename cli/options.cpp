@@ -91,6 +91,10 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_flag("--no-weak-motion-check", flags->no_weak_motion_check,
                    "A single motion the local test finds weak fails nd (by default the pose is displaced along it "
                    "and refitted: no second fit = constrained)");
+  command.add_option("--rival-distance", flags->rival_distance,
+                     "A second pose that fits counts as a rival (fails nd) only beyond this Hausdorff distance "
+                     "of the estimate: a distance (2cm, 0.02) or a fraction of d (10%d); default 2*eps_oc. "
+                     "Larger: the certified bound loosens to about this distance + eps_oc (docs/method.md)");
   command.add_option("--global-steps", flags->global_steps,
                      "Rival starts: rotations by k*360/N deg about each principal axis (N even, default 4), "
                      "and half-turns about the 10 diagonals of the principal frame");
@@ -149,13 +153,13 @@ void ResolveFreeSpaceLimits(const RobustFlags& flags, FreeSpaceOptions* options)
 
 }  // namespace
 
-void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& object,
+void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectModel& object,
                    CertificateOptions* certificate, CorrectorOptions* corrector) {
   if (!flags.max_outliers.empty()) {
     certificate->max_outliers = ParseOutlierBudget(flags.max_outliers);
   } else {
     certificate->max_outliers = OutlierBudget{};
-    if (input == InputKind::kCameraFrames && !flags.no_free_space && object.indicator_sets.empty()) {
+    if (input == InputKind::kCameraFrames && !flags.no_free_space && object.spec().indicator_sets.empty()) {
       certificate->max_outliers.fraction = kDepthImageOutlierFraction;
     }
   }
@@ -178,6 +182,8 @@ void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& 
   const bool reestimate_by_default = input == InputKind::kCameraFrames && flags.reestimate_camera_frames;
   certificate->global.reestimate = !flags.no_reestimate && (flags.reestimate || reestimate_by_default);
   certificate->global.steps = flags.global_steps;
+  certificate->global.rival_distance =
+      flags.rival_distance.empty() ? 0.0 : ParseThreshold(flags.rival_distance, object.diameter(), "--rival-distance");
   certificate->global.reestimate_steps = flags.reestimate_steps;
   if (flags.reestimate_steps < 2 || flags.reestimate_steps > 36 || flags.reestimate_steps % 2 != 0) {
     throw InputError("--reestimate-steps", std::to_string(flags.reestimate_steps) + " must be even and in [2, 36]");
@@ -202,6 +208,11 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
   std::string described = text;
   if (certificate.global.enabled) {
     described += ", global rivals " + std::to_string(RivalHypotheses(certificate.global).size());
+    if (certificate.global.rival_distance > 0.0) {
+      char beyond[48];
+      std::snprintf(beyond, sizeof beyond, " beyond %g m", certificate.global.rival_distance);
+      described += beyond;
+    }
   } else {
     described += ", global check off";
   }
@@ -220,6 +231,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (flags.reestimate) line += " --reestimate";
   if (flags.no_reestimate) line += " --no-reestimate";
   if (flags.global_steps != 4) line += " --global-steps " + std::to_string(flags.global_steps);
+  if (!flags.rival_distance.empty()) line += " --rival-distance " + flags.rival_distance;
   if (flags.reestimate_steps != 12) line += " --reestimate-steps " + std::to_string(flags.reestimate_steps);
   if (flags.no_free_space) line += " --no-free-space";
   if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;

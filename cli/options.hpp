@@ -87,6 +87,7 @@ struct RobustFlags {
   std::string free_space_accept;   // --free-space-accept ("" = default, at most the fraction)
   std::string outside_mask;        // --outside-mask-fraction ("" = default)
   std::string uncovered_mask;      // --uncovered-mask-fraction ("" = default)
+  std::string rival_distance;      // --rival-distance ("" = 2 eps_oc)
 };
 void AddRobustOptions(CLI::App& command, RobustFlags* flags);
 // What the clouds of a run are; where --max-outliers / --robust-loss are not
@@ -109,10 +110,10 @@ enum class InputKind {
   // mask is the object's, so a second basin is worth seconds).
   kCameraFrames,
 };
-// Fills the certificate's budget and local test and the corrector's kernel
+// Fills the certificate's budget, local test and rival search and the corrector's kernel
 // (InputError naming the option on a bad value). certify, eval, selftrain
 // and bench share it, so one input gets one set of defaults everywhere.
-void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectSpec& object,
+void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectModel& object,
                    CertificateOptions* certificate, CorrectorOptions* corrector);
 // "m = 2%, robust loss = tls, local nd >= 0.02" for the printed summary.
 std::string DescribeRobust(const CertificateOptions& certificate, const CorrectorOptions& corrector);

@@ -125,7 +125,7 @@ void ResolveOptions(const ObjectModel& object, SelftrainCommand* cmd) {
                                                   : InputKind::kCameraSegments;
   // Re-estimation stays opt-in here: every round certifies every instance again.
   cmd->robust.reestimate_camera_frames = false;
-  ResolveRobust(cmd->robust, input, object.spec(), &options.pipeline.certificate, &options.pipeline.corrector);
+  ResolveRobust(cmd->robust, input, object, &options.pipeline.certificate, &options.pipeline.corrector);
   if (!cmd->symmetry_tolerance.empty()) {
     options.pseudo_labels.symmetry_tolerance =
         ParseThreshold(cmd->symmetry_tolerance, object.diameter(), "--symmetry-tolerance");
