@@ -70,8 +70,13 @@ void ResolveCorrector(const CorrectorFlags& flags, CorrectorOptions* options) {
 void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_option("--max-outliers", flags->max_outliers,
                      "Outlier budget m of the certificates: a count (10) or a percentage of each cloud's points "
-                     "(2%); default 0 = the paper; certify's depth-image/BOP input of an object without indicator sets: "
-                     "2% (with the free-space test)");
+                     "(2%); default 0 = the paper; depth-image/BOP input: 2% (with the free-space test, unless "
+                     "--indicator-sets on for an object with sets)");
+  command.add_option("--indicator-sets", flags->indicator_sets,
+                     "on: nd needs one of the object's indicator sets supported (the paper's eq. 21); off: the sets "
+                     "are ignored, as for an object without any. Default on, off for depth-image/BOP input with the "
+                     "free-space test (the mask erosion removes their corners' support; docs/method.md)")
+      ->check(CLI::IsMember({"on", "off"}));
   command.add_option("--robust-loss", flags->robust_loss,
                      "Robust kernel of the corrector's point-cloud term, truncated at eps_oc: none, tls (truncated "
                      "least squares, GNC) or gm (Geman-McClure); default none, tls for depth-image/BOP input");
@@ -155,13 +160,14 @@ void ResolveFreeSpaceLimits(const RobustFlags& flags, FreeSpaceOptions* options)
 
 void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectModel& object,
                    CertificateOptions* certificate, CorrectorOptions* corrector) {
+  const bool robust_frames = input == InputKind::kCameraFrames && !flags.no_free_space;
+  certificate->use_indicator_sets = flags.indicator_sets.empty() ? !robust_frames : flags.indicator_sets == "on";
+  const bool sets_in_use = certificate->use_indicator_sets && !object.spec().indicator_sets.empty();
   if (!flags.max_outliers.empty()) {
     certificate->max_outliers = ParseOutlierBudget(flags.max_outliers);
   } else {
     certificate->max_outliers = OutlierBudget{};
-    if (input == InputKind::kCameraFrames && !flags.no_free_space && object.spec().indicator_sets.empty()) {
-      certificate->max_outliers.fraction = kDepthImageOutlierFraction;
-    }
+    if (robust_frames && !sets_in_use) certificate->max_outliers.fraction = kDepthImageOutlierFraction;
   }
   if (!flags.robust_loss.empty()) {
     corrector->robust_loss = ParseRobustLoss(flags.robust_loss);
@@ -206,6 +212,7 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
                   certificate.max_outliers.ToString().c_str(), ToString(corrector.robust_loss));
   }
   std::string described = text;
+  if (!certificate.use_indicator_sets) described += ", indicator sets off";
   if (certificate.global.enabled) {
     described += ", global rivals " + std::to_string(RivalHypotheses(certificate.global).size());
     if (certificate.global.rival_distance > 0.0) {
@@ -225,6 +232,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   std::string line;
   if (!flags.max_outliers.empty()) line += " --max-outliers " + flags.max_outliers;
   if (!flags.robust_loss.empty()) line += " --robust-loss " + flags.robust_loss;
+  if (!flags.indicator_sets.empty()) line += " --indicator-sets " + flags.indicator_sets;
   if (!flags.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + flags.nd_min_eigenvalue;
   if (flags.no_global_check) line += " --no-global-check";
   if (flags.no_weak_motion_check) line += " --no-weak-motion-check";

@@ -21,7 +21,7 @@ for c in "${commands[@]}"; do
   "$C3PO" $c --help > "help.txt" 2>&1 || fail "$c --help exited $?"
   for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue --no-global-check \
       --global-steps --no-free-space --free-space-fraction --free-space-accept --outside-mask-fraction \
-      --uncovered-mask-fraction --rival-distance; do
+      --uncovered-mask-fraction --rival-distance --indicator-sets; do
     grep -q -- "$flag" help.txt || fail "$c --help lacks $flag"
   done
   grep -q "allow_extra_args\|->" help.txt && fail "$c --help shows code: $(grep 'allow_extra_args\|->' help.txt)"
@@ -76,6 +76,7 @@ for c in certify eval; do
   bad_value --reestimate-steps "$C3PO" $c "$OBJ" "${det[@]}" --data data --reestimate --reestimate-steps 5
   bad_value --rival-distance "$C3PO" $c "$OBJ" "${det[@]}" --data data --rival-distance 0
   bad_value --rival-distance "$C3PO" $c "$OBJ" "${det[@]}" --data data --rival-distance 3x
+  bad_value --indicator-sets "$C3PO" $c "$OBJ" "${det[@]}" --data data --indicator-sets maybe
 done
 bad_value --max-outliers "$C3PO" bench corrector "$OBJ" --data data --max-outliers -2
 bad_value --eps-oc "$C3PO" eval "$OBJ" --detector manifest --data data --eps-oc auto
@@ -91,8 +92,9 @@ fi
 
 # One input, one set of defaults (options.hpp InputKind): depth frames
 # certified with their frame (certify, eval and selftrain with --bop) of an
-# object without indicator sets get m = 2% and the TLS kernel, m = 0 when the
-# free-space test is off or the object has sets; segments certified without
+# object get m = 2%, the TLS kernel and the indicator sets off (an object with
+# sets is judged as one without), m = 0 and the sets on when the free-space
+# test is off or --indicator-sets on is given; segments certified without
 # their frame (selftrain with --data as well) get TLS and m = 0; ready-made
 # clouds keep the paper (m = 0, no kernel); a flag wins. eval --bop certifies
 # what certify --bop certifies (the frame's free space included).
@@ -113,7 +115,25 @@ summary() {   # the certify summary's budget and kernel
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --robust-loss none --max-outliers 5 -o c.jsonl > c.out 2>&1 || true
 [ "$(summary c.out)" == "m = 5, robust loss = none" ] || fail "certify --bop with flags: '$(summary c.out)'"
 "$C3PO" certify "$OBJ" --bop bop --obj-id 3 --detector svd -o c.jsonl > c.out 2>&1 || true
-[ "$(summary c.out)" == "m = 0, robust loss = tls" ] || fail "certify --bop, object with sets: '$(summary c.out)'"
+[ "$(summary c.out)" == "m = 2%, robust loss = tls" ] || fail "certify --bop, object with sets: '$(summary c.out)'"
+grep -q "indicator sets off" c.out || fail "certify --bop, object with sets: summary does not say the sets are off"
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o c_nosets.jsonl > /dev/null 2>&1 || true
+"$C3PO" certify "$OBJ" --bop bop --obj-id 3 --detector svd --indicator-sets on -o c_on.jsonl > c.out 2>&1 || true
+[ "$(summary c.out)" == "m = 0, robust loss = tls" ] || fail "certify --bop --indicator-sets on: '$(summary c.out)'"
+"$C3PO" certify "$OBJ" --data data --detector svd -o c_clouds.jsonl > /dev/null 2>&1 || true
+python3 - <<'PY' || fail "--indicator-sets: the sets are not off on frames / on for clouds"
+import json
+def lines(path): return [json.loads(l) for l in open(path)]
+off, nosets, on, clouds = lines("c.jsonl"), lines("c_nosets.jsonl"), lines("c_on.jsonl"), lines("c_clouds.jsonl")
+assert off and on and clouds and len(off) == len(nosets)
+assert all(not l["nd_sets_used"] for l in off + nosets), off
+assert all(l["nd_sets_used"] and l["max_outliers"] == 0 for l in on + clouds), on + clouds
+# Sets off = the same object without sets: the same decisions and poses.
+for a, b in zip(off, nosets):
+    assert (a["certified"], a["refused_by"], a["R"], a["t"]) == (b["certified"], b["refused_by"], b["R"], b["t"]), (a, b)
+PY
+"$C3PO" certify "$OBJ" --bop bop --obj-id 3 --detector svd --indicator-sets off --no-free-space -o c.jsonl > c.out 2>&1 || true
+[ "$(summary c.out)" == "m = 0, robust loss = tls" ] || fail "certify --bop --indicator-sets off --no-free-space: '$(summary c.out)'"
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --no-free-space -o c.jsonl > c.out 2>&1 || true
 [ "$(summary c.out)" == "m = 0, robust loss = tls" ] || fail "certify --bop --no-free-space: '$(summary c.out)'"
 "$C3PO" certify "$NOSETS" --data data --detector svd -o c.jsonl > c.out 2>&1 || true

@@ -346,7 +346,7 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "restart_axis", "restart_angle_deg", "max_outliers",
                                          "robust_loss", "robust_scale", "outliers", "outlier_indices", "outlier_indices_truncated",
                                          "distance_quantiles", "max_inlier_distance", "keypoint_support",
-                                         "nd_set_support", "nd_sets", "nd_local", "nd_local_eigenvalue",
+                                         "nd_set_support", "nd_sets", "nd_sets_used", "nd_local", "nd_local_eigenvalue",
                                          "nd_local_motion", "nd_local_rank", "nd_local_weak_motions",
                                          "nd_weak_motion", "weak_motion_starts", "weak_motion_rivals",
                                          "weak_motion_rival_step", "weak_motion_rival_hausdorff", "nd_global",
@@ -394,6 +394,7 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
   CHECK(j["keypoint_support"].get<std::vector<int>>() == nd.keypoint_support);
   CHECK(j["nd_set_support"].get<std::vector<int>>() == nd.set_min_support);
   CHECK(j["nd_sets"].get<bool>() == nd.sets_passed);
+  CHECK(j["nd_sets_used"].get<bool>() == nd.sets_used);
   REQUIRE(nd.local_checked);
   CHECK(j["nd_local"].get<bool>() == nd.local.passed);
   CHECK(j["nd_local_eigenvalue"].get<double>() == nd.local.min_eigenvalue);

@@ -193,6 +193,27 @@ TEST_CASE("nd_m fails when an indicator keypoint has only m supporting points") 
     options.eps_oc = 0.01;   // now accepted: m + 1 supports
     CHECK(CheckNonDegeneracy(mug, with_off, Pose(), options).keypoint_support[0] == m + 1);
   }
+  SUBCASE("sets off (the camera-frame default): the object is judged as if it had none") {
+    // The body alone: the handle keypoint has no support at all, so its set
+    // fails for every m; with the sets off nothing about them is decided.
+    const PointSet cloud = Columns(all, body);
+    for (int m : {0, 2}) {
+      CAPTURE(m);
+      CertificateOptions options = WithBudget(mug, Count(m));
+      const NonDegeneracy on = CheckNonDegeneracy(mug, cloud, Pose(), options);
+      CHECK(on.sets_used);
+      CHECK(on.keypoint_support[0] == 0);
+      CHECK_FALSE(on.sets_passed);
+      options.use_indicator_sets = false;
+      const NonDegeneracy off = CheckNonDegeneracy(mug, cloud, Pose(), options);
+      CHECK_FALSE(off.sets_used);
+      CHECK(off.sets_passed);
+      CHECK(off.passing_set == -1);
+      CHECK(off.set_min_support.empty());
+      CHECK(off.local.passed == on.local.passed);   // the local test does not depend on the sets
+      CHECK(off.passed == off.local.passed);
+    }
+  }
 }
 
 TEST_CASE("degenerate clouds of a non-planar object are never certified") {

@@ -168,7 +168,9 @@ NonDegeneracy CheckNonDegeneracy(const ObjectModel& object, const PointSet& clou
       if ((cloud.col(j) - posed_keypoints.col(i)).squaredNorm() < delta2) ++nd.keypoint_support[i];
     }
   }
-  const auto& sets = object.spec().indicator_sets;
+  static const std::vector<std::vector<int>> kNoSets;
+  const auto& sets = options.use_indicator_sets ? object.spec().indicator_sets : kNoSets;
+  nd.sets_used = !sets.empty();
   for (std::size_t s = 0; s < sets.size(); ++s) {
     double worst = 0.0;
     int support = std::numeric_limits<int>::max();

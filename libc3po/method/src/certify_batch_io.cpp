@@ -94,6 +94,7 @@ void AddRobustKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["keypoint_support"] = nd.keypoint_support;
   line["nd_set_support"] = nd.set_min_support;
   line["nd_sets"] = nd.sets_passed;
+  line["nd_sets_used"] = nd.sets_used;
   line["nd_local"] = nd.local_checked ? nlohmann::ordered_json(nd.local.passed) : nlohmann::ordered_json(nullptr);
   line["nd_local_eigenvalue"] = FiniteOrNull(nd.local.min_eigenvalue);
   line["nd_local_motion"] = {nd.local.motion(0), nd.local.motion(1), nd.local.motion(2),

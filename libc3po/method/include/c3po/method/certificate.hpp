@@ -49,6 +49,11 @@ struct CertificateOptions {
   bool check_keypoint_agreement = true;
   OutlierBudget max_outliers;                  // m
   bool local_nondegeneracy = true;             // the local test is part of nd
+  // false: nd ignores the object's indicator sets (as for an object without
+  // any); the camera-frame default (docs/method.md "Indicator sets on camera
+  // frames"): their corner keypoints lose their support to the mask erosion,
+  // and with a percentage budget no delta_nd ball holds m + 1 points.
+  bool use_indicator_sets = true;
   LocalNonDegeneracyOptions local;
   GlobalUniquenessOptions global;              // the rival search (pipeline.hpp runs it)
   FreeSpaceOptions free_space;                 // depth-image inputs (pipeline.hpp runs it)
@@ -86,7 +91,8 @@ struct NonDegeneracy {
   double delta_nd = 0.0;
   int max_outliers = 0;
   int passing_set = -1;                   // first set that passed, -1 if none / no sets
-  bool sets_passed = false;               // some set passed, or the object has none
+  bool sets_passed = false;               // some set passed, or the object has none (or they are not used)
+  bool sets_used = false;                 // the object has sets and CertificateOptions::use_indicator_sets
   std::vector<double> set_worst_distance; // per set: max_{i in G_l} dist(ŷ_i, X)
   std::vector<int> set_min_support;       // per set: min_{i in G_l} support count
   Eigen::VectorXd keypoint_distances;     // per keypoint: min_x ||ŷ_i - x||
