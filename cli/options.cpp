@@ -102,7 +102,7 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                      "Larger: the certified bound loosens to about this distance + eps_oc (docs/method.md)");
   command.add_option("--global-steps", flags->global_steps,
                      "Rival starts: rotations by k*360/N deg about each principal axis (N even, default 4), "
-                     "and half-turns about the 10 diagonals of the principal frame");
+                     "half-turns about the 10 diagonals of the principal frame, and the estimate itself");
   command.add_flag("--no-free-space", flags->no_free_space,
                    "Depth-image inputs: no free-space test (on by default)");
   command.add_option("--free-space-fraction", flags->free_space_fraction,

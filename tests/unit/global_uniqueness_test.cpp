@@ -91,14 +91,16 @@ PointSet BoxOnlyCloud(int count, std::uint64_t seed) {
 
 TEST_CASE("global uniqueness: hypotheses and axis rotations") {
   GlobalUniquenessOptions options;
-  // 3 x 3 turns about the principal axes, then the 10 diagonals' half-turns.
+  // 3 x 3 turns about the principal axes, then the 10 diagonals' half-turns,
+  // then the estimate itself (no turn).
   const std::vector<std::pair<int, double>> hypotheses = RivalHypotheses(options);
-  REQUIRE(hypotheses.size() == 19);
+  REQUIRE(hypotheses.size() == 20);
   CHECK(hypotheses[0] == std::make_pair(0, M_PI / 2));
   CHECK(hypotheses[8] == std::make_pair(2, 3 * M_PI / 2));
   for (int k = 9; k < 19; ++k) CHECK(hypotheses[k] == std::make_pair(k - 6, M_PI));
+  CHECK(hypotheses[19] == std::make_pair(0, 0.0));
   options.steps = 6;
-  CHECK(RivalHypotheses(options).size() == 15 + 10);
+  CHECK(RivalHypotheses(options).size() == 15 + 10 + 1);
   options.steps = 3;
   CHECK_THROWS(options.Check());
   const ObjectModel object = BumpedBox();
@@ -169,7 +171,7 @@ TEST_CASE("global uniqueness: a planted two-fold rival is refused, the discrimin
   CHECK(good.certificate.nd.global_checked);
   CHECK(good.certificate.nd.global.passed);
   CHECK(good.certified());
-  CHECK(good.certificate.nd.global.rivals_tried == 19);
+  CHECK(good.certificate.nd.global.rivals_tried == 20);
 }
 
 TEST_CASE("global uniqueness: a symmetric object's turns are not rivals") {
@@ -183,6 +185,68 @@ TEST_CASE("global uniqueness: a symmetric object's turns are not rivals") {
   CHECK(e.certificate.nd.global_checked);
   CHECK(e.certificate.nd.global.passed);
   CHECK(e.certified());
+}
+
+TEST_CASE("global uniqueness: a given pose the data put elsewhere has its rival at its own refit") {
+  // A 0.30 m bar seen only at one end (x < -0.05). The given pose turns the
+  // truth by 0.12 rad about z through (-0.10, 0, 0), inside the seen part:
+  // every seen point moves < 8 mm (< eps_oc = 10 mm: oc passes with no
+  // outlier) while the far end moves ~30 mm. The local test cannot object
+  // (the seen end constrains every motion); the refit from the given pose
+  // settles back at the truth, a second fit beyond 2 eps_oc.
+  const ObjectModel bar = PlainBox({0.30, 0.08, 0.05});
+  const Pose truth = TestPose();
+  const PointSet all = SampleSurface(bar.mesh(), 6000, 3);
+  std::vector<Eigen::Index> seen;
+  for (Eigen::Index i = 0; i < all.cols(); ++i) {
+    if (all(0, i) < -0.05) seen.push_back(i);
+  }
+  PointSet end(3, static_cast<Eigen::Index>(seen.size()));
+  for (std::size_t k = 0; k < seen.size(); ++k) end.col(static_cast<Eigen::Index>(k)) = all.col(seen[k]);
+  const PointSet cloud = truth * end;
+  Pose turn;
+  turn.R = Eigen::AngleAxisd(0.12, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d pivot(-0.10, 0.0, 0.0);
+  turn.t = pivot - turn.R * pivot;
+  const Pose given = truth * turn;
+  const PointSet queries = StridedColumns(bar.sample(), 1000);
+  const double wrong_by = PosedModelHausdorff(bar, queries, truth, given);
+  REQUIRE(wrong_by > 2.0 * bar.spec().eps_oc);   // beyond the bound: must not be certified
+
+  PipelineOptions options = Options(bar);
+  options.correct = false;   // certify the pose as given (certify --poses --no-correct)
+  PipelineOptions unsearched = options;
+  unsearched.certificate.global.enabled = false;
+  const PoseEstimate blind = EstimateAndCertify(bar, cloud, given * bar.keypoints(), unsearched);
+  REQUIRE(blind.ok());
+  CHECK(blind.certificate.oc.passed);            // the case is real: only the search can refuse it
+  CHECK(blind.certificate.oc.outlier_count == 0);
+  CHECK(blind.certificate.nd.local.passed);
+
+  const PoseEstimate e = EstimateAndCertify(bar, cloud, given * bar.keypoints(), options);
+  REQUIRE(e.ok());
+  CHECK_FALSE(e.certified());
+  CHECK(RefusedBy(e.certificate) == std::vector<CertificatePart>{CertificatePart::kNdGlobal});
+  const GlobalUniqueness& g = e.certificate.nd.global;
+  CHECK(g.rival_hausdorff > g.rival_distance);
+  // The rival is the truth (up to the corrector's settling and the bar's
+  // symmetries), not another wrong pose.
+  CHECK(PosedModelHausdorff(bar, queries, truth, g.rival_scene_from_model) < bar.spec().eps_oc);
+  // The own refit alone finds it (the bar's symmetric half-turns find it too;
+  // a shape without them has only this start near the truth).
+  const auto hypotheses = RivalHypotheses(options.certificate.global);
+  CHECK(std::count(hypotheses.begin(), hypotheses.end(), std::make_pair(0, 0.0)) == 1);
+  const std::vector<RivalFit> own = RefineRivals(bar, cloud, blind, options, ModelPrincipalFrame(bar), {{0, 0.0}});
+  REQUIRE(own.size() == 1);
+  CHECK(own[0].ok);
+  CHECK(own[0].passes_oc);
+  CHECK(own[0].hausdorff > g.rival_distance);
+  CHECK(PosedModelHausdorff(bar, queries, truth, own[0].scene_from_model) < bar.spec().eps_oc);
+
+  // At the truth the refit stays: certified, the own refit among the 20 tried.
+  const PoseEstimate at_truth = EstimateAndCertify(bar, cloud, truth * bar.keypoints(), options);
+  CHECK(at_truth.certified());
+  CHECK(at_truth.certificate.nd.global.rivals_tried == 20);
 }
 
 namespace {

@@ -285,6 +285,22 @@ TEST_CASE("refusal: every failed part is named with its evidence, nothing when c
     CHECK(RefusalSummary(c).find("(budget 2)") != std::string::npos);
     CHECK(RefusedBy(Certify(object, far, truth, keypoints, WithBudget(object, Count(3)))).empty());
   }
+  SUBCASE("a counting rival: nd_global names where it is, the own refit in words") {
+    Certificate c = whole;
+    c.nd.global_checked = true;
+    c.nd.global.passed = false;
+    c.nd.passed = false;
+    c.nd.global.rival_axis = 0;
+    c.nd.global.rival_hausdorff = 0.031;
+    c.nd.global.rival_outliers = 4;
+    c.nd.global.rival_distance = 0.02;
+    c.nd.global.rival_angle_deg = 180.0;
+    CHECK(RefusedBy(c) == Parts{CertificatePart::kNdGlobal});
+    CHECK(RefusalSummary(c).rfind("nd_global: a pose 0.031 away (180 deg about axis 0) leaves 4 points", 0) == 0);
+    c.nd.global.rival_angle_deg = 0.0;   // RivalHypotheses' last start: the estimate itself
+    CHECK(RefusalSummary(c).rfind("nd_global: the corrector moves the pose 0.031 away, where it leaves 4 points",
+                                  0) == 0);
+  }
   SUBCASE("corrected keypoints off the posed model's: oc_keypoints only") {
     PointSet off = keypoints;
     off.col(1) += Eigen::Vector3d(0.0, 2.0 * eps_oc, 0.0);

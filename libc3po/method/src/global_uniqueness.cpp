@@ -82,6 +82,7 @@ std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOption
     for (int k = 1; k < options.steps; ++k) hypotheses.emplace_back(axis, 2.0 * M_PI * k / options.steps);
   }
   for (int axis = 3; axis < 13; ++axis) hypotheses.emplace_back(axis, M_PI);
+  hypotheses.emplace_back(0, 0.0);   // T̂ itself: its refit must not settle beyond rival_distance
   return hypotheses;
 }
 

@@ -62,6 +62,11 @@ std::string Evidence(CertificatePart part, const Certificate& c) {
                     "eps_oc)", nd.weak_motion.rival_step, nd.weak_motion.rival_hausdorff,
                     nd.weak_motion.rival_outliers);
     case CertificatePart::kNdGlobal:
+      if (nd.global.rival_angle_deg == 0.0) {   // the estimate's own refit (RivalHypotheses)
+        return Format("the corrector moves the pose %.3g away, where it leaves %d points at >= eps_oc (rival "
+                      "distance %.3g)", nd.global.rival_hausdorff, nd.global.rival_outliers,
+                      nd.global.rival_distance);
+      }
       return Format("a pose %.3g away (%.0f deg about axis %d) leaves %d points at >= eps_oc (rival distance %.3g)",
                     nd.global.rival_hausdorff, nd.global.rival_angle_deg, nd.global.rival_axis,
                     nd.global.rival_outliers, nd.global.rival_distance);

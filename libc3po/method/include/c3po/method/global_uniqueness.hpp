@@ -9,7 +9,8 @@
 // steps-1, so the half-turns are always among them), and at the half-turns
 // about the 10 diagonals of the principal frame (ReestimateAxes 3-12: where
 // two extents are alike the principal axes are oblique to the object's own,
-// and a flip about those is reached only from a diagonal), and each rival is
+// and a flip about those is reached only from a diagonal), and at T̂ itself
+// (a given pose the corrector would move far), and each rival is
 // refined. A refined rival T' that
 //   - passes oc_m with the same ε_oc and budget m as T̂ (and, for depth-image
 //     inputs, the free-space test: free_space.hpp), and
@@ -45,7 +46,7 @@ struct GlobalUniquenessOptions {
   int reestimate_steps = 12;   // even, in [2, 36]
   // Rotations by k·360°/steps about each principal axis, k = 1 .. steps-1
   // (even: the half-turns are included). 4: 90°, 180°, 270° (9 rivals; with
-  // the 10 diagonal half-turns, 19).
+  // the 10 diagonal half-turns and T̂'s own refit, 20).
   int steps = 4;
   // A rival counts when Hausdorff(T̂·B̂, T'·B̂) > rival_distance; 0 = 2·eps_oc.
   // Two poses that both satisfy the guarantee lie within eps_oc + eps_w of
@@ -124,7 +125,10 @@ std::vector<RivalFit> RefineRivals(const ObjectModel& object, const PointSet& cl
                                    const std::vector<std::pair<int, double>>& hypotheses);
 
 // The (axis, angle) hypotheses of the options: 3 × (steps - 1) turns about
-// the principal axes, then the half-turns about the diagonals 3-12.
+// the principal axes, then the half-turns about the diagonals 3-12, then
+// (0, 0): the estimate itself, refitted -- where the corrector settles from
+// T̂. A pose the data put elsewhere (a given pose, `--poses --no-correct`,
+// whose nearby best fit lies beyond rival_distance) has its rival there.
 std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOptions& options);
 
 // The 13 axes of the re-estimation (columns, unit): the principal axes (0-2),
