@@ -353,7 +353,7 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "rivals_tried",
                                          "rivals_found", "rival_distance", "rival_hausdorff", "rival_outliers",
                                          "rival_axis", "rival_angle_deg", "rival_passes_oc",
-                                         "rival_free_space_violations", "rival_R", "rival_t", "free_space",
+                                         "rival_free_space_violations", "rival_counts", "rival_R", "rival_t", "free_space",
                                          "free_space_violations", "free_space_measured",
                                          "free_space_silhouette", "free_space_tolerance", "free_space_limit",
                                          "free_space_shift_px", "through_support", "seen_surface",

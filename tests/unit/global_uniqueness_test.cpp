@@ -143,6 +143,7 @@ TEST_CASE("global uniqueness: a planted two-fold rival is refused, the discrimin
   CHECK_FALSE(at_truth.certificate.nd.global.passed);
   CHECK_FALSE(at_truth.certified());
   CHECK(at_truth.certificate.nd.global.rivals_found >= 1);
+  CHECK(at_truth.certificate.nd.global.rival_counts);
   CHECK(at_truth.certificate.nd.global.rival_passes_oc);
   // The rival is the half-turn: the bump (0.04 above the top face) moved to
   // the other end, so its top is ~0.04 from the rival's surface.
@@ -1170,6 +1171,26 @@ TEST_CASE("re-estimation: a restart that also explains the cloud is a rival of t
   CHECK_FALSE(filtered.passed);
   CHECK(filtered.rivals_found == 1);
   CHECK((filtered.rival_scene_from_model.t - far_left.t).norm() < 1e-12);
+  CHECK(filtered.rival_counts);
+
+  // The global search reported a farther pose that passes oc but not free
+  // space (it does not count); the restart rival that does count replaces it,
+  // so the evidence names the pose that refused the estimate.
+  Pose farther = chosen;
+  farther.t.x() -= 0.09;
+  GlobalUniqueness reported;
+  reported.rival_distance = global.rival_distance;
+  reported.rival_axis = 1;
+  reported.rival_hausdorff = PosedModelHausdorff(object, queries, chosen, farther);
+  reported.rival_passes_oc = true;
+  reported.rival_counts = false;
+  reported.rival_scene_from_model = farther;
+  REQUIRE(reported.rival_hausdorff > 0.05 + 0.03);
+  AddRestartRivals(object, fits, chosen, &filter, &reported);
+  CHECK(reported.rivals_found == 1);
+  CHECK(reported.rival_counts);
+  CHECK(reported.rival_axis == 4);
+  CHECK((reported.rival_scene_from_model.t - far_left.t).norm() < 1e-12);
 }
 
 TEST_CASE("global uniqueness: a mug seen side-on, flipped upside down, is refused (the flip axis is not principal)") {

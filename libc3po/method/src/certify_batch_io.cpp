@@ -129,6 +129,7 @@ void AddRivalKeys(const NonDegeneracy& nd, nlohmann::ordered_json* out) {
   line["rival_angle_deg"] = g.rival_angle_deg;
   line["rival_passes_oc"] = g.rival_passes_oc;
   line["rival_free_space_violations"] = g.rival_free_space_violations;
+  line["rival_counts"] = g.rival_counts;
   // The reported rival's pose (scene_from_model, like R and t): the second explanation to look at.
   const Pose& rival = g.rival_scene_from_model;
   line["rival_R"] = g.rival_axis >= 0 ? RotationJson(rival.R) : nlohmann::ordered_json(nullptr);

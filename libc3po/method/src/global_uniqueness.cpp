@@ -248,6 +248,7 @@ GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet
       global.rival_budget_distance = fit.budget_distance;
       global.rival_passes_oc = fit.passes_oc;
       global.rival_free_space_violations = violations;
+      global.rival_counts = counts;
       global.rival_scene_from_model = fit.scene_from_model;
     }
   }
@@ -266,7 +267,9 @@ void AddRestartRivals(const ObjectModel& object, const std::vector<RivalFit>& fi
     int violations = -1;
     if (filter && !filter->Passes(fit.scene_from_model, &violations)) continue;
     ++global->rivals_found;
-    if (global->rival_axis >= 0 && global->rival_passes_oc && !(hausdorff > global->rival_hausdorff)) continue;
+    // The report shows a rival that counts: this one, unless a farther one
+    // that counts is there already (a non-counting report is replaced).
+    if (global->rival_counts && !(hausdorff > global->rival_hausdorff)) continue;
     global->rival_axis = fit.axis;
     global->rival_angle_deg = fit.angle * 180.0 / M_PI;
     global->rival_hausdorff = hausdorff;
@@ -274,6 +277,7 @@ void AddRestartRivals(const ObjectModel& object, const std::vector<RivalFit>& fi
     global->rival_budget_distance = fit.budget_distance;
     global->rival_passes_oc = true;
     global->rival_free_space_violations = violations;
+    global->rival_counts = true;
     global->rival_scene_from_model = fit.scene_from_model;
   }
   global->passed = global->rivals_found == 0;

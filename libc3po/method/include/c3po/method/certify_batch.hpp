@@ -166,7 +166,8 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   (null when not run: something else failed, or --no-global-check),
 //   rivals_tried, rivals_found, rival_distance, rival_hausdorff (null: no
 //   distinct rival), rival_outliers, rival_axis, rival_angle_deg,
-//   rival_passes_oc, rival_free_space_violations (-1: not checked), rival_R
+//   rival_passes_oc, rival_free_space_violations (-1: not checked),
+//   rival_counts (the reported rival is one that refuses), rival_R
 //   and rival_t (the reported rival's pose; null without one); free space
 //   (free_space.hpp; depth-image inputs): free_space (null when not checked),
 //   free_space_violations, free_space_measured, free_space_silhouette,

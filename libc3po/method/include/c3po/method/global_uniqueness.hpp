@@ -85,6 +85,7 @@ struct GlobalUniqueness {
   double rival_budget_distance = 0.0;   // its (m+1)-th largest point distance
   bool rival_passes_oc = false;
   int rival_free_space_violations = -1; // depth-image inputs: its free-space evidence (-1: not checked)
+  bool rival_counts = false;    // the reported rival is one of rivals_found (always, when rivals_found > 0)
   Pose rival_scene_from_model;
 };
 
