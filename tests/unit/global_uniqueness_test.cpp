@@ -1235,3 +1235,53 @@ TEST_CASE("global uniqueness: a mug seen side-on, flipped upside down, is refuse
     }
   }
 }
+
+TEST_CASE("rival fits: fitted to the cloud, judged on the evidence (the re-estimation's restarts)") {
+  // The cloud (the estimate's, eroded) shows only the symmetric box; the
+  // evidence adds the bump's top. The half-turn about z explains the cloud
+  // but not the evidence: judged on the evidence it must not pass the
+  // rivals' oc (docs/method.md "Evidence: the whole mask").
+  const ObjectModel object = BumpedBox();
+  const Pose truth = TestPose();
+  const PipelineOptions options = Options(object);
+  const PointSet cloud = truth * BoxOnlyCloud(3000, 3);
+  const PointSet bump_surface = SampleSurface(test::BoxMesh({0.07, 0.0, 0.05}, {0.04, 0.04, 0.04}), 4000, 5);
+  std::vector<Eigen::Index> top;
+  for (Eigen::Index j = 0; j < bump_surface.cols(); ++j) {
+    if (bump_surface(2, j) > 0.065) top.push_back(j);
+  }
+  REQUIRE(top.size() > 200);
+  PointSet evidence(3, cloud.cols() + 200);
+  evidence.leftCols(cloud.cols()) = cloud;
+  for (int k = 0; k < 200; ++k) evidence.col(cloud.cols() + k) = truth * Eigen::Vector3d(bump_surface.col(top[k]));
+
+  Pose half_turn;
+  half_turn.R = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  half_turn.t.setZero();
+  const PoseEstimate at_truth = EstimateAndCertify(object, cloud, truth * object.keypoints(), options);
+  REQUIRE(at_truth.ok());
+  const std::vector<RivalStart> starts = {{2, M_PI, truth * half_turn}};
+  for (bool refine : {false, true}) {
+    CAPTURE(refine);
+    const std::vector<RivalFit> on_cloud = FitRivals(object, cloud, at_truth, options, starts, refine);
+    const std::vector<RivalFit> on_evidence = FitRivals(object, cloud, at_truth, options, starts, refine, &evidence);
+    REQUIRE(on_cloud.size() == 1);
+    REQUIRE(on_evidence.size() == 1);
+    REQUIRE(on_cloud[0].ok);
+    REQUIRE(on_evidence[0].ok);
+    // The same fit (the evidence never moves it) ...
+    CHECK((on_cloud[0].scene_from_model.R - on_evidence[0].scene_from_model.R).norm() < 1e-9);
+    CHECK((on_cloud[0].scene_from_model.t - on_evidence[0].scene_from_model.t).norm() < 1e-9);
+    CHECK(on_cloud[0].hausdorff > 0.035);   // the bump at the other end: a far pose
+    CHECK(on_cloud[0].passes_oc);
+    // ... judged on the points given: brute-force count of the evidence's
+    // points at >= eps_oc from the model posed at the fit.
+    const Eigen::VectorXd d = object.DistancesToPosedModel(evidence, on_evidence[0].scene_from_model);
+    const int beyond = static_cast<int>((d.array() >= object.spec().eps_oc).count());
+    CHECK(beyond >= 150);   // the bump's top points (0.04 above the rival's top face)
+    CHECK(on_evidence[0].outliers == beyond);
+    // Budget of the evidence: m = 0 + max(1 % of 3200, 10) = 32 < beyond.
+    CHECK(options.certificate.global.RivalSlack(evidence.cols()) < beyond);
+    CHECK_FALSE(on_evidence[0].passes_oc);
+  }
+}

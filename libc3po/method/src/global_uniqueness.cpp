@@ -104,16 +104,18 @@ Eigen::Matrix<double, 3, 13> ReestimateAxes(const PrincipalFrame& frame) {
 }
 
 std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
-                                const PipelineOptions& pipeline, const std::vector<RivalStart>& starts, bool refine) {
+                                const PipelineOptions& pipeline, const std::vector<RivalStart>& starts, bool refine,
+                                const PointSet* evidence) {
+  const PointSet& judged = evidence ? *evidence : cloud;
   PipelineOptions rival_options = pipeline;
   rival_options.correct = refine;   // a refined rival is where the corrector settles from the start
   rival_options.certificate.global.enabled = false;
   rival_options.certificate.global.reestimate = false;
   rival_options.certificate.local_nondegeneracy = false;   // only the rival's oc is needed
   // The rivals' budget: m + the slack (global_uniqueness.hpp).
-  const int m = pipeline.certificate.max_outliers.Resolve(cloud.cols());
+  const int m = pipeline.certificate.max_outliers.Resolve(judged.cols());
   rival_options.certificate.max_outliers = OutlierBudget{};
-  rival_options.certificate.max_outliers.count = m + pipeline.certificate.global.RivalSlack(cloud.cols());
+  rival_options.certificate.max_outliers.count = m + pipeline.certificate.global.RivalSlack(judged.cols());
   const PointSet queries = StridedColumns(object.sample(), 1000);
   // The starts are independent: both cores for one pose (inline inside a
   // batch's worker, parallel.hpp); each fit goes to its own slot.
@@ -124,8 +126,8 @@ std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud
     fit.axis = start.axis;
     fit.angle = start.angle;
     fit.start = start.scene_from_model;
-    const PoseEstimate rival =
-        EstimateAndCertify(object, cloud, start.scene_from_model * object.keypoints(), rival_options);
+    const PoseEstimate rival = EstimateAndCertify(object, cloud, start.scene_from_model * object.keypoints(),
+                                                  rival_options, nullptr, evidence);
     fit.ok = rival.ok();
     if (fit.ok) {
       fit.scene_from_model = rival.scene_from_model;

@@ -73,11 +73,13 @@ std::vector<RivalStart> ReestimateStarts(const ObjectModel& object, const Pose& 
 // replacement must have no other restart as a rival (AddRestartRivals).
 void Reestimate(const ObjectModel& object, const PointSet& cloud, const PointSet& evidence,
                 const PipelineOptions& options, const FreeSpaceTest* free_space, PoseEstimate* estimate) {
-  // The candidates are estimates: fitted to `cloud` like the detector's; the
-  // chosen one is certified against `evidence` in full.
+  // The candidates are estimates: fitted to `cloud` like the detector's,
+  // judged (the rivals' oc) on `evidence` like every rival of the chosen pose;
+  // the chosen one is certified against `evidence` in full.
   const std::vector<RivalFit> fits =
       FitRivals(object, cloud, *estimate, options,
-                ReestimateStarts(object, estimate->scene_from_model, options.certificate.global.reestimate_steps), true);
+                ReestimateStarts(object, estimate->scene_from_model, options.certificate.global.reestimate_steps), true,
+                &evidence);
   // Candidates by their outlier count (the rivals' looser budget), best first.
   std::vector<std::size_t> order;
   for (std::size_t i = 0; i < fits.size(); ++i) {

@@ -152,8 +152,13 @@ struct RivalStart {
 };
 // Fits every start on `cloud` (the rivals' budget and options as in
 // RefineRivals); with refine = false the start itself is judged (no corrector).
+// Each fit's oc is judged on `evidence` when given (the re-estimation fits
+// its restarts to the estimate's cloud but, like the estimate, judges them on
+// the certificate's evidence: docs/method.md "Evidence: the whole mask"),
+// else on `cloud`; the budget m + slack is that of the judged points.
 std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
-                                const PipelineOptions& pipeline, const std::vector<RivalStart>& starts, bool refine);
+                                const PipelineOptions& pipeline, const std::vector<RivalStart>& starts, bool refine,
+                                const PointSet* evidence = nullptr);
 
 // The finite check of a single weak motion (local_nondegeneracy.hpp): the
 // first-order test refuses a box seen on two faces because sliding along
