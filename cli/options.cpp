@@ -107,7 +107,7 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                    "Depth-image inputs: no free-space test (on by default)");
   command.add_option("--free-space-fraction", flags->free_space_fraction,
                      "Depth-image inputs: a rival pose (or re-estimation candidate) that sees through more than this "
-                     "fraction of its measured silhouette pixels is refuted (default 0.03)");
+                     "fraction of its measured silhouette pixels is refuted (default 0.02)");
   command.add_option("--free-space-accept", flags->free_space_accept,
                      "Depth-image inputs: the estimate is certified only if it sees through at most this fraction "
                      "(default 0.015, at most --free-space-fraction)");

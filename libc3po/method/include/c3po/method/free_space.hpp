@@ -69,12 +69,17 @@ struct FreeSpaceOptions {
   bool enabled = true;
   double tolerance = 0.0;      // metres behind the surface; 0 = max(eps_oc, min_tolerance)
   double min_tolerance = 0.01; // floor of the automatic tolerance (real depth noise, mask edges)
-  // Of the measured counted pixels. Measured (docs/method.md "Free space"):
-  // <= 0.5 % at the ground-truth poses of all 200 real YCB-V instances, <= 0.02 %
-  // at the artefact scenes' ground truth; 3.9-4.9 % for the real
-  // pudding boxes' diagonal half-turn rivals, 7-10 % for a mustard bottle
-  // posed on other objects' segments.
-  double max_fraction = 0.03;
+  // Of the measured counted pixels. A rival is refuted above it, so it must
+  // lie above what the truth -- and the corrector's refit near the truth,
+  // where a rival standing for the truth settles -- shows. Measured
+  // (docs/method.md "Free space", "The rivals' limit 3 % -> 2 %"): <= 0.5 %
+  // at the ground-truth poses of all 200 real YCB-V instances, <= 0.61 % at
+  // their refits from 5° off (within 2·eps_oc of the truth), <= 0.02 % at
+  // the artefact scenes' ground truth, <= 1.1 % at their estimates within
+  // 2·eps_oc; 2.1-3.0 % for the artefact bananas' flipped rivals, 3.9-4.9 %
+  // for the real pudding boxes' diagonal half-turn rivals, 7-10 % for a
+  // mustard bottle posed on other objects' segments.
+  double max_fraction = 0.02;
   // The estimate's limit (same measure). Measured: certified correct real
   // poses <= 0.36 %; other objects' segments accepted at 3 % saw through
   // 1.8-2.9 % (a sugar box, a pudding box inside potted-meat-can segments).
