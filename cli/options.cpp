@@ -96,6 +96,10 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
   command.add_flag("--no-weak-motion-check", flags->no_weak_motion_check,
                    "A single motion the local test finds weak fails nd (by default the pose is displaced along it "
                    "and refitted: no second fit = constrained)");
+  command.add_flag("--no-centre", flags->no_centre,
+                   "A pose refused only by rivals within twice the rival distance stays refused (by default the "
+                   "centre of it and its rivals is certified instead when it passes everything and lies within the "
+                   "rival distance of all of them)");
   command.add_option("--rival-distance", flags->rival_distance,
                      "A second pose that fits counts as a rival (fails nd) only beyond this Hausdorff distance "
                      "of the estimate: a distance (2cm, 0.02) or a fraction of d (10%d); default 2*eps_oc. "
@@ -185,6 +189,7 @@ void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectModel&
   }
   certificate->global.enabled = !flags.no_global_check;
   certificate->local.weak_motion_check = !flags.no_weak_motion_check;
+  certificate->global.centre = !flags.no_centre;
   const bool reestimate_by_default = input == InputKind::kCameraFrames && flags.reestimate_camera_frames;
   certificate->global.reestimate = !flags.no_reestimate && (flags.reestimate || reestimate_by_default);
   certificate->global.steps = flags.global_steps;
@@ -225,6 +230,7 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
   }
   // Re-estimation runs with or without the rival search (pipeline.cpp).
   if (certificate.global.reestimate) described += ", re-estimation on";
+  if (!certificate.global.centre) described += ", centring off";
   return described;
 }
 
@@ -236,6 +242,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (!flags.nd_min_eigenvalue.empty()) line += " --nd-min-eigenvalue " + flags.nd_min_eigenvalue;
   if (flags.no_global_check) line += " --no-global-check";
   if (flags.no_weak_motion_check) line += " --no-weak-motion-check";
+  if (flags.no_centre) line += " --no-centre";
   if (flags.reestimate) line += " --reestimate";
   if (flags.no_reestimate) line += " --no-reestimate";
   if (flags.global_steps != 4) line += " --global-steps " + std::to_string(flags.global_steps);

@@ -81,6 +81,7 @@ struct RobustFlags {
   // eval: on; selftrain sets it off -- its rounds certify every instance again).
   bool reestimate_camera_frames = true;
   bool no_weak_motion_check = false;   // --no-weak-motion-check: a single weak motion fails nd
+  bool no_centre = false;              // --no-centre: a pose refused by near rivals is not centred
   int global_steps = 4;            // --global-steps
   int reestimate_steps = 12;       // --reestimate-steps
   bool no_free_space = false;      // --no-free-space (depth-image inputs)

@@ -21,7 +21,7 @@ for c in "${commands[@]}"; do
   "$C3PO" $c --help > "help.txt" 2>&1 || fail "$c --help exited $?"
   for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue --no-global-check \
       --global-steps --no-free-space --free-space-fraction --free-space-accept --outside-mask-fraction \
-      --uncovered-mask-fraction --rival-distance --indicator-sets; do
+      --uncovered-mask-fraction --rival-distance --indicator-sets --no-centre; do
     grep -q -- "$flag" help.txt || fail "$c --help lacks $flag"
   done
   grep -q "allow_extra_args\|->" help.txt && fail "$c --help shows code: $(grep 'allow_extra_args\|->' help.txt)"
@@ -150,6 +150,9 @@ grep -q "re-estimation on" c.out && fail "certify --bop --no-reestimate re-estim
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --no-global-check -o c.jsonl > c.out 2>&1 || true
 grep -q "global check off, re-estimation on" c.out || fail "certify --bop --no-global-check: $(head -3 c.out)"
 bad_value "--reestimate" "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --reestimate --no-reestimate
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --no-centre -o nc.jsonl > nc.out 2>&1 || true
+grep -q "re-estimation on, centring off" nc.out || fail "certify --no-centre: $(head -3 nc.out)"
+grep -q "centring" c.out && fail "certify without --no-centre mentions centring: $(head -3 c.out)"
 # --rival-distance: a second fit counts as a rival only beyond it (default
 # 2*eps_oc). The cube's second frame is refused by nd_global for a rival at
 # Hausdorff h from its estimate; given a distance D > h that rival no longer

@@ -343,7 +343,7 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "oc_distance",
                                          "keypoint_distance", "nd_set", "nd_set_distances", "eps_oc", "delta_nd",
                                          "iterations", "cost_before", "cost_after", "status", "restarts_tried",
-                                         "restart_axis", "restart_angle_deg", "max_outliers",
+                                         "restart_axis", "restart_angle_deg", "centred", "centred_fits", "max_outliers",
                                          "robust_loss", "robust_scale", "outliers", "outlier_indices", "outlier_indices_truncated",
                                          "distance_quantiles", "max_inlier_distance", "keypoint_support",
                                          "nd_set_support", "nd_sets", "nd_sets_used", "nd_local", "nd_local_eigenvalue",

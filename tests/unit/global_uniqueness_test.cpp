@@ -1285,3 +1285,159 @@ TEST_CASE("rival fits: fitted to the cloud, judged on the evidence (the re-estim
     CHECK_FALSE(on_evidence[0].passes_oc);
   }
 }
+
+namespace {
+
+// Symmetric Hausdorff distance between two point sets, by brute force.
+double BruteHausdorff(const PointSet& a, const PointSet& b) {
+  const auto directed = [](const PointSet& from, const PointSet& to) {
+    double worst = 0.0;
+    for (Eigen::Index i = 0; i < from.cols(); ++i) {
+      worst = std::max(worst, (to.colwise() - from.col(i)).colwise().norm().minCoeff());
+    }
+    return worst;
+  };
+  return std::max(directed(a, b), directed(b, a));
+}
+
+// The box translated by `x` along its own x axis (the faces' common edge).
+Pose SlidAlongX(const Pose& pose, double x) {
+  Pose slid = pose;
+  slid.t += pose.R * Eigen::Vector3d(x, 0, 0);
+  return slid;
+}
+
+}  // namespace
+
+TEST_CASE("centring: the centre of fits is their midpoint (analytic) and a single pose is itself") {
+  const ObjectModel box = PlainBox({0.20, 0.12, 0.06});
+  const Eigen::Vector3d c = box.sample().rowwise().mean();
+  const Pose base = TestPose();
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.2, -1, 0.4).normalized();
+  const double angle = 0.5;
+  const Eigen::Vector3d shift(0.03, -0.02, 0.01);
+  // Two poses turned by -angle/2 and +angle/2 about `axis` through the posed
+  // centroid and moved by -shift/2, +shift/2: their centre is `base`.
+  const auto turned = [&](double sign) {
+    Pose turn;
+    turn.R = Eigen::AngleAxisd(sign * angle / 2, axis).toRotationMatrix();
+    const Eigen::Vector3d posed_centroid = base * c;
+    turn.t = posed_centroid - turn.R * posed_centroid + sign * shift / 2;
+    Pose composed;
+    composed.R = turn.R * base.R;
+    composed.t = turn.R * base.t + turn.t;
+    return composed;
+  };
+  const Pose centre = CentreOfFits(box, {turned(1), turned(-1)});
+  CHECK((centre.R - base.R).norm() < 1e-12);
+  CHECK((centre.t - base.t).norm() < 1e-12);
+  CHECK(centre.R.determinant() == doctest::Approx(1.0).epsilon(1e-12));
+  const Pose single = CentreOfFits(box, {base});
+  CHECK((single.R - base.R).norm() < 1e-12);
+  CHECK((single.t - base.t).norm() < 1e-12);
+  CHECK_THROWS_AS(CentreOfFits(box, {}), std::invalid_argument);
+}
+
+TEST_CASE("centring: an estimate at one end of a valley of fits narrower than 2*rho is replaced by its centre") {
+  // The two faces of the box with |x| <= 8.5 cm of its 10 cm half-length:
+  // every slide along x by s in [-1.5, 1.5] cm explains each point (the
+  // valley, 3 cm wide: between rho = 2 eps_oc = 2 cm and 2 rho). The truth is
+  // its centre; the estimate starts at its end, s = +1.5 cm.
+  const ObjectModel box = PlainBox({0.20, 0.12, 0.06});
+  const Pose truth = TestPose();
+  const double rho = 2.0 * box.spec().eps_oc;
+  const PointSet cloud = truth * TwoFaces(0.085, 11);
+  const Pose end = SlidAlongX(truth, 0.015);
+  const PointSet queries = StridedColumns(box.sample(), 500);
+
+  PipelineOptions off = Options(box);
+  off.certificate.global.centre = false;
+  const PoseEstimate refused = EstimateAndCertify(box, cloud, end * box.keypoints(), off);
+  REQUIRE(refused.ok());
+  CHECK(refused.certificate.oc.passed);
+  CHECK(RefusedBy(refused.certificate) == std::vector<CertificatePart>{CertificatePart::kNdWeakMotion});
+  CHECK_FALSE(refused.centred);
+  const std::vector<Pose>& rivals = refused.certificate.nd.weak_motion.rival_poses;
+  REQUIRE_FALSE(rivals.empty());
+  CHECK(static_cast<int>(rivals.size()) == refused.certificate.nd.weak_motion.rivals_found);
+  const double end_error = BruteHausdorff(refused.scene_from_model * queries, truth * queries);
+  CHECK(end_error > 0.5 * rho);   // the corrector stayed near the valley's end
+
+  const PoseEstimate centred = EstimateAndCertify(box, cloud, end * box.keypoints(), Options(box));
+  REQUIRE(centred.ok());
+  CHECK(centred.certified());
+  CHECK(centred.centred);
+  CHECK(centred.centred_fits == static_cast<int>(rivals.size()) + 1);
+  // Oracles: the brute-force Hausdorff distances. The centre lies within rho
+  // of the refused estimate and of every rival it was refused for, and it is
+  // the valley's centre, the truth, within the certificate's eps_oc.
+  const PointSet posed = centred.scene_from_model * queries;
+  CHECK(BruteHausdorff(posed, refused.scene_from_model * queries) <= rho);
+  for (const Pose& rival : rivals) CHECK(BruteHausdorff(posed, rival * queries) <= rho);
+  const double centre_error = BruteHausdorff(posed, truth * queries);
+  CHECK(centre_error < box.spec().eps_oc);
+  CHECK(centre_error < end_error);
+  // Every test was applied to the centre itself.
+  CHECK(centred.certificate.oc.outlier_count == 0);
+  CHECK(centred.certificate.nd.weak_motion_checked);
+  CHECK(centred.certificate.nd.weak_motion.passed);
+  CHECK(centred.certificate.nd.global_checked);
+  CHECK(centred.certificate.nd.global.passed);
+}
+
+TEST_CASE("centring: a valley wider than 2*rho stays refused wherever the estimate starts in it") {
+  // |x| <= 6 cm of 10: slides in [-4, 4] cm fit, a valley of 8 cm = 4 rho.
+  // No pose is within rho of every fit, so none may be certified.
+  const ObjectModel box = PlainBox({0.20, 0.12, 0.06});
+  const Pose truth = TestPose();
+  const PointSet cloud = truth * TwoFaces(0.06, 13);
+  for (const double s : {-0.04, -0.02, 0.0, 0.01, 0.03}) {
+    CAPTURE(s);
+    const PoseEstimate e =
+        EstimateAndCertify(box, cloud, SlidAlongX(truth, s) * box.keypoints(), Options(box));
+    REQUIRE(e.ok());
+    CHECK(e.certificate.oc.passed);
+    CHECK_FALSE(e.certified());
+  }
+}
+
+TEST_CASE("soundness of centring: with the truth at a valley's end, no certificate farther than rho from it") {
+  // The worst case for centring: the data are a valley of fits (two faces of
+  // the box along |x| <= h, slides by up to 10 cm - h either way explain
+  // them) and the truth is one of its ends, the estimate started anywhere in
+  // it. A certified pose must lie within rho of the truth (the search's
+  // bound: the truth's refit is a fit found from some start), whatever the
+  // valley's width -- narrower than 2 rho (the centre is within rho of both
+  // ends) or wider (refused).
+  const ObjectModel box = PlainBox({0.20, 0.12, 0.06});
+  const Pose middle = TestPose();
+  const double rho = 2.0 * box.spec().eps_oc;
+  const PointSet queries = StridedColumns(box.sample(), 500);
+  Rng rng(29);
+  int certified = 0, runs = 0;
+  for (const double h : {0.09, 0.085, 0.08, 0.07, 0.06}) {
+    PointSet cloud = middle * TwoFaces(h, 17);
+    for (Eigen::Index j = 0; j < cloud.cols(); ++j) {
+      cloud.col(j) += 0.0005 * Eigen::Vector3d(rng.Normal(), rng.Normal(), rng.Normal());
+    }
+    const double half_width = 0.10 - h;
+    for (const double end : {-1.0, 1.0}) {
+      const Pose truth = SlidAlongX(middle, end * half_width);
+      for (const double start : {-1.0, 0.0, 1.0}) {
+        CAPTURE(h);
+        CAPTURE(end);
+        CAPTURE(start);
+        const PoseEstimate e = EstimateAndCertify(
+            box, cloud, SlidAlongX(middle, start * half_width) * box.keypoints(), Options(box));
+        ++runs;
+        if (!e.certified()) continue;
+        ++certified;
+        // rho plus the sample spacing of the posed queries (500 of 20000 points).
+        CHECK(BruteHausdorff(e.scene_from_model * queries, truth * queries) <= rho + 0.003);
+        if (2.0 * half_width > 2.0 * rho + 0.003) CHECK_FALSE(e.certified());   // no pose within rho of both ends
+      }
+    }
+  }
+  MESSAGE(certified << " of " << runs << " certified");
+  CHECK(certified > 0);   // the narrow valleys are certified (centred): the test is not vacuous
+}

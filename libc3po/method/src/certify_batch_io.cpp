@@ -74,6 +74,9 @@ void AddPoseAndDecisionKeys(const PoseEstimate& e, nlohmann::ordered_json* out) 
   line["restarts_tried"] = e.restarts_tried;
   line["restart_axis"] = e.restart_axis;
   line["restart_angle_deg"] = e.restart_angle_deg;
+  // Centring (GlobalUniquenessOptions::centre): the pose is the centre of this many fits.
+  line["centred"] = e.centred;
+  line["centred_fits"] = e.centred_fits;
 }
 
 // Outlier-robust evidence (docs/method.md "Outlier-robust certificates"): oc_m and nd_m's support and local test.

@@ -2,6 +2,7 @@
 #include "c3po/method/global_uniqueness.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -103,6 +104,26 @@ Eigen::Matrix<double, 3, 13> ReestimateAxes(const PrincipalFrame& frame) {
   return axes;
 }
 
+Pose CentreOfFits(const ObjectModel& object, const std::vector<Pose>& poses) {
+  if (poses.empty()) throw std::invalid_argument("CentreOfFits needs at least one pose");
+  const Eigen::Vector3d centroid = object.sample().rowwise().mean();
+  Eigen::Matrix3d rotation_sum = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d posed_centroid = Eigen::Vector3d::Zero();
+  for (const Pose& pose : poses) {
+    rotation_sum += pose.R;
+    posed_centroid += pose.R * centroid + pose.t;
+  }
+  posed_centroid /= static_cast<double>(poses.size());
+  // argmax_R tr(R^T sum): R = U diag(1, 1, det(U V^T)) V^T (the chordal mean).
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(rotation_sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
+  sign(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  Pose centre;
+  centre.R = svd.matrixU() * sign * svd.matrixV().transpose();
+  centre.t = posed_centroid - centre.R * centroid;
+  return centre;
+}
+
 std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud, const PoseEstimate& estimate,
                                 const PipelineOptions& pipeline, const std::vector<RivalStart>& starts, bool refine,
                                 const PointSet* evidence) {
@@ -111,6 +132,7 @@ std::vector<RivalFit> FitRivals(const ObjectModel& object, const PointSet& cloud
   rival_options.correct = refine;   // a refined rival is where the corrector settles from the start
   rival_options.certificate.global.enabled = false;
   rival_options.certificate.global.reestimate = false;
+  rival_options.certificate.global.centre = false;
   rival_options.certificate.local_nondegeneracy = false;   // only the rival's oc is needed
   // The rivals' budget: m + the slack (global_uniqueness.hpp).
   const int m = pipeline.certificate.max_outliers.Resolve(judged.cols());
@@ -199,6 +221,7 @@ WeakMotionCheck CheckWeakMotion(const ObjectModel& object, const PointSet& cloud
       int violations = -1;
       if (RivalCounts(fit, rival_distance, filter, &violations)) {
         ++check.rivals_found;
+        check.rival_poses.push_back(fit.scene_from_model);
         if (fit.hausdorff > check.rival_hausdorff) {
           check.rival_hausdorff = fit.hausdorff;
           check.rival_step = fit.angle;
@@ -238,7 +261,10 @@ GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet
     if (!fit.ok || !(fit.hausdorff > global.rival_distance)) continue;   // failed, or T̂'s own basin
     int violations = -1;
     const bool counts = RivalCounts(fit, global.rival_distance, filter, &violations);
-    if (counts) ++global.rivals_found;
+    if (counts) {
+      ++global.rivals_found;
+      global.rival_poses.push_back(fit.scene_from_model);
+    }
     const auto fit_key = key(counts, fit);
     if (!have_best || fit_key < best_key) {
       have_best = true;
@@ -269,6 +295,7 @@ void AddRestartRivals(const ObjectModel& object, const std::vector<RivalFit>& fi
     int violations = -1;
     if (filter && !filter->Passes(fit.scene_from_model, &violations)) continue;
     ++global->rivals_found;
+    global->rival_poses.push_back(fit.scene_from_model);
     // The report shows a rival that counts: this one, unless a farther one
     // that counts is there already (a non-counting report is replaced).
     if (global->rival_counts && !(hausdorff > global->rival_hausdorff)) continue;

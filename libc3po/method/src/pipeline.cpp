@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "c3po/geometry/registration.hpp"
 
@@ -89,6 +91,7 @@ void Reestimate(const ObjectModel& object, const PointSet& cloud, const PointSet
                    [&](std::size_t a, std::size_t b) { return fits[a].outliers < fits[b].outliers; });
   PipelineOptions once = options;
   once.certificate.global.reestimate = false;
+  once.certificate.global.centre = false;   // the chosen pose is centred once, by the caller
   for (const std::size_t i : order) {
     int violations = -1;
     if (free_space && !free_space->Passes(fits[i].scene_from_model, &violations)) continue;
@@ -108,6 +111,62 @@ void Reestimate(const ObjectModel& object, const PointSet& cloud, const PointSet
     break;
   }
   estimate->restarts_tried = static_cast<int>(fits.size());
+}
+
+// The rivals that alone refuse a pose that fits the observation (oc_m, free
+// space, the sets, the local test up to its weak motion): the weak-motion
+// check's or the global search's. Empty when anything else refuses.
+std::vector<Pose> RefusingRivals(const Certificate& certificate) {
+  const NonDegeneracy& nd = certificate.nd;
+  if (!certificate.fits_observation() || !nd.sets_passed || nd.passed) return {};
+  if (nd.weak_motion_checked && !nd.weak_motion.passed) return nd.weak_motion.rival_poses;
+  if (nd.local_checked && !nd.local.passed && !nd.weak_motion_checked) return {};
+  if (nd.global_checked && !nd.global.passed) return nd.global.rival_poses;
+  return {};
+}
+
+// GlobalUniquenessOptions::centre: a pose refused only by rivals that all lie
+// within 2·rho of it is replaced by the centre of the two of these fits (it
+// and its rivals) farthest apart when that centre is certified in full and
+// every one of the fits lies within rho of it (docs/method.md "Centring a
+// valley of fits").
+void Centre(const ObjectModel& object, const PointSet& judged, const PipelineOptions& options,
+            const FreeSpaceTest* free_space, PoseEstimate* estimate) {
+  std::vector<Pose> fits = RefusingRivals(estimate->certificate);
+  if (fits.empty()) return;
+  const double eps_oc = options.certificate.eps_oc;
+  const GlobalUniquenessOptions& global = options.certificate.global;
+  const double rho = global.rival_distance > 0.0 ? global.rival_distance : 2.0 * eps_oc;
+  const PointSet queries = StridedColumns(object.sample(), 1000);
+  for (const Pose& rival : fits) {
+    if (!(PosedModelHausdorff(object, queries, estimate->scene_from_model, rival) <= 2.0 * rho)) return;
+  }
+  fits.push_back(estimate->scene_from_model);
+  // The centre of the two fits farthest apart: for a valley of fits along one
+  // motion (a slide, a turn about an axis) the pose nearest to all of them.
+  std::pair<std::size_t, std::size_t> ends{0, fits.size() - 1};
+  double diameter = -1.0;
+  for (std::size_t i = 0; i < fits.size(); ++i) {
+    for (std::size_t j = i + 1; j < fits.size(); ++j) {
+      const double d = PosedModelHausdorff(object, queries, fits[i], fits[j]);
+      if (d > diameter) {
+        diameter = d;
+        ends = {i, j};
+      }
+    }
+  }
+  PoseEstimate centred = *estimate;
+  centred.scene_from_model = CentreOfFits(object, {fits[ends.first], fits[ends.second]});
+  centred.keypoints = centred.scene_from_model * object.keypoints();
+  centred.certificate = Certify(object, judged, centred.scene_from_model, centred.keypoints, options.certificate);
+  CompleteCertificate(object, judged, options, free_space, &centred);
+  if (!centred.certified()) return;
+  for (const Pose& fit : fits) {
+    if (!(PosedModelHausdorff(object, queries, centred.scene_from_model, fit) <= rho)) return;
+  }
+  centred.centred = true;
+  centred.centred_fits = static_cast<int>(fits.size());
+  *estimate = std::move(centred);
 }
 
 }  // namespace
@@ -148,6 +207,9 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
     CompleteCertificate(object, judged, options, free_space, &estimate);
     if (options.correct && options.certificate.global.reestimate && Refuted(estimate.certificate)) {
       Reestimate(object, cloud, judged, options, free_space, &estimate);
+    }
+    if (options.correct && options.certificate.global.centre) {
+      Centre(object, judged, options, free_space, &estimate);
     }
   } else {
     estimate.certificate.oc.eps_oc = options.certificate.eps_oc;

@@ -149,7 +149,9 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   nd_set_distances, eps_oc, delta_nd, iterations, cost_before, cost_after
 //   (null when not finite), status (registration), restarts_tried,
 //   restart_axis and restart_angle_deg (re-estimation: axis -1 when the
-//   detector's estimate was kept; global_uniqueness.hpp), then the outlier-robust
+//   detector's estimate was kept; global_uniqueness.hpp), centred and
+//   centred_fits (the pose is the centre of that many fits: the refused
+//   estimate and its near rivals; GlobalUniquenessOptions::centre), then the outlier-robust
 //   evidence (docs/method.md "Outlier-robust certificates"): max_outliers (m
 //   for this cloud), robust_loss and robust_scale (the corrector's kernel and
 //   its truncation c, 0 without a kernel), outliers (count at >= eps_oc), outlier_indices (the first

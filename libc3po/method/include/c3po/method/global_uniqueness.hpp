@@ -44,6 +44,15 @@ struct GlobalUniquenessOptions {
   // one, the search itself found a second explanation: nd.global fails.
   bool reestimate = false;
   int reestimate_steps = 12;   // even, in [2, 36]
+  // Centring (docs/method.md "Centring a valley of fits"): when the estimate
+  // passes everything except the rivals (the global search's or the weak
+  // motion's) and every rival lies within 2·rival_distance of it, the fits
+  // found are one flat valley of explanations, not two: the pose at their
+  // centre (CentreOfFits) is certified in full instead, rival search included,
+  // and replaces the estimate when it passes and every fit found lies within
+  // rival_distance of it. Choosing which pose to certify cannot make a
+  // certificate unsound (every test is applied to the pose reported).
+  bool centre = true;
   // Rotations by k·360°/steps about each principal axis, k = 1 .. steps-1
   // (even: the half-turns are included). 4: 90°, 180°, 270° (9 rivals; with
   // the 10 diagonal half-turns and T̂'s own refit, 20).
@@ -87,6 +96,7 @@ struct GlobalUniqueness {
   int rival_free_space_violations = -1; // depth-image inputs: its free-space evidence (-1: not checked)
   bool rival_counts = false;    // the reported rival is one of rivals_found (always, when rivals_found > 0)
   Pose rival_scene_from_model;
+  std::vector<Pose> rival_poses;   // every rival that counts (the search's, then the restarts'), for centring
 };
 
 // Principal axes of the model sample (columns, decreasing extent, right-handed) and its centroid.
@@ -137,6 +147,14 @@ std::vector<std::pair<int, double>> RivalHypotheses(const GlobalUniquenessOption
 // (9-12) -- the rotation axes of a cube's symmetries in the principal frame.
 Eigen::Matrix<double, 3, 13> ReestimateAxes(const PrincipalFrame& frame);
 
+// The pose at the centre of `poses` (scene_from_model, at least one): the
+// chordal mean of the rotations (the sum projected onto SO(3)) turning the
+// model about its sample centroid c, which goes to the mean of the posed
+// centroids R_i c + t_i. For poses that differ by small motions it is their
+// midpoint to first order; Hausdorff distances from it are what centring
+// checks, not assumed.
+Pose CentreOfFits(const ObjectModel& object, const std::vector<Pose>& poses);
+
 // An extra test a rival must pass to count (the free-space test of depth-image
 // inputs, free_space.hpp): whether the pose passes and its violation count.
 struct RivalFilter {
@@ -182,6 +200,7 @@ struct WeakMotionCheck {
   int rival_outliers = -1;        // its outlier count (-1: none)
   double fewest_outliers_step = 0.0;  // without a rival: the distinct displacement that came closest
   int fewest_outliers = -1;
+  std::vector<Pose> rival_poses;   // every rival found, for centring
 };
 
 // The displacement by s along the unit twist ξ (LocalNonDegeneracy::motion)

@@ -34,6 +34,12 @@ struct PoseEstimate {
   int restart_axis = -1;
   double restart_angle_deg = 0.0;
   int restarts_tried = 0;
+  // Centring (GlobalUniquenessOptions::centre): the estimate was refused only
+  // by rivals within 2·rival_distance, and the pose reported is the centre of
+  // the `centred_fits` fits (the refused estimate and its rivals), certified
+  // in full. false: the estimate (or the re-estimation's pose) as fitted.
+  bool centred = false;
+  int centred_fits = 0;
   bool ok() const { return correction.ok(); }
   bool certified() const { return ok() && certificate.certified(); }
 };
