@@ -13,6 +13,7 @@
 #include "c3po/eval/evaluation.hpp"
 #include "c3po/geometry/render.hpp"
 #include "c3po/method/free_space.hpp"
+#include "brute_force.hpp"
 #include "evaluation_fixture.hpp"
 #include "test_helpers.hpp"
 
@@ -33,25 +34,6 @@ double MeanNearest(const PointSet& a, const PointSet& b) {
 double BruteAddS(const ObjectModel& object, const Pose& truth, const Pose& estimate, AddSVariant variant) {
   const PointSet a = truth * object.sample(), b = estimate * object.sample();
   return MeanNearest(a, b) + (variant == AddSVariant::kSymmetric ? MeanNearest(b, a) : 0.0);
-}
-
-double DistanceToSet(const Eigen::Vector3d& q, const PointSet& points) {
-  return (points.colwise() - q).colwise().norm().minCoeff();
-}
-
-// max_i min_j ||a_i - b_j||, by brute force.
-double MaxNearest(const PointSet& a, const PointSet& b) {
-  double worst = 0.0;
-  for (Eigen::Index i = 0; i < a.cols(); ++i) worst = std::max(worst, DistanceToSet(a.col(i), b));
-  return worst;
-}
-
-// The symmetric Hausdorff distance between the model posed at the truth and
-// at the estimate, 2000 strided points of B̂ against all of B̂ (both ways).
-double BruteHausdorff(const ObjectModel& object, const Pose& truth, const Pose& estimate) {
-  const PointSet queries = StridedColumns(object.sample(), 2000);
-  return std::max(MaxNearest(truth * queries, estimate * object.sample()),
-                  MaxNearest(estimate * queries, truth * object.sample()));
 }
 
 // oc and nd of an estimate by brute force (docs/method.md "Certificates").
@@ -126,7 +108,7 @@ std::vector<double> CheckSamples(const Fixture& f, const EvaluationRow& row, con
     CHECK(s.oc == oc);
     CHECK(s.nd == nd);
     if (s.certified()) {
-      CHECK(s.hausdorff == doctest::Approx(BruteHausdorff(f.object, truth, s.scene_from_model)).epsilon(1e-9));
+      CHECK(s.hausdorff == doctest::Approx(BrutePosedHausdorff(f.object, truth, s.scene_from_model)).epsilon(1e-9));
     } else {
       CHECK(std::isnan(s.hausdorff));
     }

@@ -21,6 +21,7 @@
 #include "c3po/method/pipeline.hpp"
 #include "c3po/method/refusal.hpp"
 #include "c3po/object/object_io.hpp"
+#include "brute_force.hpp"
 #include "test_helpers.hpp"
 #include "test_objects.hpp"
 
@@ -1288,18 +1289,6 @@ TEST_CASE("rival fits: fitted to the cloud, judged on the evidence (the re-estim
 
 namespace {
 
-// Symmetric Hausdorff distance between two point sets, by brute force.
-double BruteHausdorff(const PointSet& a, const PointSet& b) {
-  const auto directed = [](const PointSet& from, const PointSet& to) {
-    double worst = 0.0;
-    for (Eigen::Index i = 0; i < from.cols(); ++i) {
-      worst = std::max(worst, (to.colwise() - from.col(i)).colwise().norm().minCoeff());
-    }
-    return worst;
-  };
-  return std::max(directed(a, b), directed(b, a));
-}
-
 // The box translated by `x` along its own x axis (the faces' common edge).
 Pose SlidAlongX(const Pose& pose, double x) {
   Pose slid = pose;
@@ -1348,7 +1337,6 @@ TEST_CASE("centring: an estimate at one end of a valley of fits narrower than 2*
   const double rho = 2.0 * box.spec().eps_oc;
   const PointSet cloud = truth * TwoFaces(0.085, 11);
   const Pose end = SlidAlongX(truth, 0.015);
-  const PointSet queries = StridedColumns(box.sample(), 500);
 
   PipelineOptions off = Options(box);
   off.certificate.global.centre = false;
@@ -1360,7 +1348,7 @@ TEST_CASE("centring: an estimate at one end of a valley of fits narrower than 2*
   const std::vector<Pose>& rivals = refused.certificate.nd.weak_motion.rival_poses;
   REQUIRE_FALSE(rivals.empty());
   CHECK(static_cast<int>(rivals.size()) == refused.certificate.nd.weak_motion.rivals_found);
-  const double end_error = BruteHausdorff(refused.scene_from_model * queries, truth * queries);
+  const double end_error = test::BrutePosedHausdorff(box, refused.scene_from_model, truth, 500);
   CHECK(end_error > 0.5 * rho);   // the corrector stayed near the valley's end
 
   const PoseEstimate centred = EstimateAndCertify(box, cloud, end * box.keypoints(), Options(box));
@@ -1371,10 +1359,10 @@ TEST_CASE("centring: an estimate at one end of a valley of fits narrower than 2*
   // Oracles: the brute-force Hausdorff distances. The centre lies within rho
   // of the refused estimate and of every rival it was refused for, and it is
   // the valley's centre, the truth, within the certificate's eps_oc.
-  const PointSet posed = centred.scene_from_model * queries;
-  CHECK(BruteHausdorff(posed, refused.scene_from_model * queries) <= rho);
-  for (const Pose& rival : rivals) CHECK(BruteHausdorff(posed, rival * queries) <= rho);
-  const double centre_error = BruteHausdorff(posed, truth * queries);
+  const Pose& centre = centred.scene_from_model;
+  CHECK(test::BrutePosedHausdorff(box, centre, refused.scene_from_model, 500) <= rho);
+  for (const Pose& rival : rivals) CHECK(test::BrutePosedHausdorff(box, centre, rival, 500) <= rho);
+  const double centre_error = test::BrutePosedHausdorff(box, centre, truth, 500);
   CHECK(centre_error < box.spec().eps_oc);
   CHECK(centre_error < end_error);
   // Every test was applied to the centre itself.
@@ -1412,7 +1400,6 @@ TEST_CASE("soundness of centring: with the truth at a valley's end, no certifica
   const ObjectModel box = PlainBox({0.20, 0.12, 0.06});
   const Pose middle = TestPose();
   const double rho = 2.0 * box.spec().eps_oc;
-  const PointSet queries = StridedColumns(box.sample(), 500);
   Rng rng(29);
   int certified = 0, runs = 0;
   for (const double h : {0.09, 0.085, 0.08, 0.07, 0.06}) {
@@ -1432,8 +1419,8 @@ TEST_CASE("soundness of centring: with the truth at a valley's end, no certifica
         ++runs;
         if (!e.certified()) continue;
         ++certified;
-        // rho plus the sample spacing of the posed queries (500 of 20000 points).
-        CHECK(BruteHausdorff(e.scene_from_model * queries, truth * queries) <= rho + 0.003);
+        // rho plus the sampling error of the brute force (500 strided points against all 20000).
+        CHECK(test::BrutePosedHausdorff(box, e.scene_from_model, truth, 500) <= rho + 0.003);
         if (2.0 * half_width > 2.0 * rho + 0.003) CHECK_FALSE(e.certified());   // no pose within rho of both ends
       }
     }
