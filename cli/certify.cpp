@@ -49,6 +49,7 @@ struct CertifyCommand {
   std::string bop_csv_path;
   std::string shard;
   std::string poses_path;   // certify given poses (docs/method.md "Certifying poses from any estimator")
+  std::vector<std::string> other_object_paths;   // identity among known objects (identity_check.hpp)
   ReportFlags report;       // --report, --views: the certify report (web/certify_report.hpp)
 };
 
@@ -75,13 +76,17 @@ std::string HumanLine(const std::string& cloud, const CloudOutcome& outcome) {
   return std::string(text) + "  refused by " + RefusalSummary(e.certificate);
 }
 
-// "eps_oc = ..., delta_nd = ... (object units; d = ...); m = 2%, robust loss = ...".
+// "eps_oc = ..., delta_nd = ... (object units; d = ...); m = 2%, robust loss = ...[; evidence: ...]
+// [; other objects: J.json, ...]".
 std::string Settings(const CertificateOptions& certificate, const CertifyBatchOptions& options,
                      const ObjectModel& object, const std::string& evidence) {
   char text[160];
   std::snprintf(text, sizeof text, "eps_oc = %.6g, delta_nd = %.6g (object units; d = %.6g); ", certificate.eps_oc,
                 certificate.delta_nd, object.diameter());
-  return text + DescribeRobust(certificate, options.pipeline.corrector) + evidence;
+  std::string identity;
+  for (const KnownObject& other : options.other_objects) identity += (identity.empty() ? "" : ", ") + other.name;
+  if (!identity.empty()) identity = "; other objects: " + identity;
+  return text + DescribeRobust(certificate, options.pipeline.corrector) + evidence + identity;
 }
 
 // "; refused by nd_global 36, oc 10": every failed part counted once per
@@ -294,6 +299,37 @@ CertifyBatchOptions CertifyOptions(const CertifyCommand& cmd, const ObjectModel&
   return options;
 }
 
+// --other-objects: each object's certifier as this command would run it on
+// that object (its own eps_oc and delta_nd from the same flags, the
+// training-free SVD detector), kept alive for the batch.
+struct OtherObjects {
+  std::vector<std::unique_ptr<ObjectModel>> objects;
+  std::vector<std::unique_ptr<Detector>> detectors;
+};
+
+void AddOtherObjects(const CertifyCommand& cmd, const ObjectModel& object, OtherObjects* others,
+                     CertifyBatchOptions* options) {
+  if (cmd.other_object_paths.empty()) return;
+  if (options->auto_eps_oc) {
+    throw InputError("--other-objects", "each object's certifier needs an eps_oc given, not auto");
+  }
+  for (const std::string& path : cmd.other_object_paths) {
+    others->objects.push_back(std::make_unique<ObjectModel>(LoadObject(path)));
+    const ObjectModel& other = *others->objects.back();
+    if (other.spec().name == object.spec().name && other.num_keypoints() == object.num_keypoints() &&
+        other.diameter() == object.diameter()) {
+      throw InputError(path, "is the object being certified, not another one");
+    }
+    others->detectors.push_back(MakeDetector("", "svd", other));
+    KnownObject known;
+    known.name = path;
+    known.object = &other;
+    known.detector = others->detectors.back().get();
+    known.pipeline = CertifyOptions(cmd, other).pipeline;
+    options->other_objects.push_back(std::move(known));
+  }
+}
+
 // Every cloud given: cloud files, --data's dataset, a --depth/--mask frame,
 // --bop's instances, in that order.
 std::vector<CloudSource> CertifySources(const CertifyCommand& cmd, const SegmentOptions& segment) {
@@ -347,7 +383,9 @@ int Run(const CertifyCommand& cmd) {
   }
   cmd.report.Check();
   const ObjectModel object = LoadObject(cmd.object_path);
-  const CertifyBatchOptions options = CertifyOptions(cmd, object);
+  CertifyBatchOptions options = CertifyOptions(cmd, object);
+  OtherObjects others;
+  AddOtherObjects(cmd, object, &others, &options);
   const std::optional<Shard> shard = cmd.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(cmd.shard));
   SegmentOptions segment = cmd.segment;
   ResolveEvidence(cmd.evidence_erode_mask, options.pipeline.certificate, &segment);
@@ -412,6 +450,13 @@ RunFunction SetupCertify(CLI::App& command) {
                      "with --poses one row per instance: its chosen hypothesis, else its best fit")
       ->check(WritableFile());
   AddShardOption(command, &cmd->shard, "clouds (by image for --bop, by cloud or manifest line otherwise)");
+  command
+      .add_option("--other-objects", cmd->other_object_paths,
+                  "Other known objects (object JSON, repeatable or comma-separated): a pose is certified only if none "
+                  "of their certifiers (SVD detector, their own thresholds) certifies the cloud too "
+                  "(refused_by identity; docs/method.md \"Identity among known objects\")")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   AddReportOptions(command, &cmd->report,
                    "poses certified and refused by each certificate part, 3D examples with the reason and the "
                    "rival pose");

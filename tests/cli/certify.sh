@@ -7,6 +7,7 @@ C3PO=$(realpath "$1"); SRC=$(realpath "$2"); WORK=$(realpath -m "$3")
 rm -rf "$WORK"; mkdir -p "$WORK"; cd "$WORK"
 OBJ="$SRC/annotations/drill.json"
 fail() { echo "FAIL: $*"; exit 1; }
+source "$SRC/tests/cli/lib.sh"
 
 # Depth clouds whose detected keypoints are the ground truth slightly perturbed.
 "$C3PO" synth "$OBJ" -o good --kind depth --count 6 --pose easy --noise 0.0005 \
@@ -93,5 +94,36 @@ set +e
 set -e
 [ $s_cert -le 1 ] && [ "$(wc -l < badgt.jsonl)" -eq 1 ] || fail "certify refused a manifest for ground truth it does not use (exit $s_cert)"
 [ $s_eval -eq 2 ] && grep -q "not orthonormal" badgt_eval.err || fail "eval accepted a non-rotation (exit $s_eval)"
+
+# --other-objects (identity among known objects): each named object's
+# certifier runs on every certified cloud; a cloud it certifies too is refused
+# by "identity". The drill's clouds given with the chair: the chair's
+# certifier must not take a drill's cloud, so the certificates stand and carry
+# the check's evidence; given with the drill itself named as "other", exit 2.
+set +e
+"$C3PO" certify "$OBJ" --detector manifest --data good --json --other-objects "$SRC/annotations/chair.json" \
+        > other.jsonl 2> other.err; s_other=$?
+set -e
+[ $s_other -le 1 ] || fail "--other-objects chair: exit $s_other"
+python3 - good.jsonl other.jsonl <<'PY' || fail "--other-objects chair changed a certificate or lacks the identity evidence"
+import json, sys
+alone = [json.loads(l) for l in open(sys.argv[1])]
+other = [json.loads(l) for l in open(sys.argv[2])]
+assert len(alone) == len(other) == 6
+for a, o in zip(alone, other):
+    assert a["certified"] == o["certified"], (a["cloud"], o["refused_by"])
+    assert a["identity"] is None
+    if o["certified"]:
+        assert o["identity"] is True and o["identity_objects"] == 1 and o["identity_rival"] is None, o
+    else:
+        assert o["identity"] is None and o["identity_objects"] == 0, o   # checked only for certified poses
+PY
+set +e
+"$C3PO" certify "$OBJ" --detector manifest --data good --other-objects "$SRC/annotations/chair.json" > other.txt; set -e
+grep -q "; other objects: $SRC/annotations/chair.json" other.txt || fail "summary does not name the other objects"
+expect_bad_input - "nosuch.json" "$C3PO" certify "$OBJ" --detector manifest --data good --other-objects nosuch.json
+expect_bad_input - "not another one" "$C3PO" certify "$OBJ" --detector manifest --data good --other-objects "$OBJ"
+expect_bad_input - "--other-objects" "$C3PO" certify "$OBJ" --detector manifest --data good --eps-oc auto \
+                 --other-objects "$SRC/annotations/chair.json"
 
 echo "certify CLI: OK ($certified/6 certified with manifest keypoints)"

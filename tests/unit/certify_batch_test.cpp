@@ -358,7 +358,8 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "free_space_silhouette", "free_space_tolerance", "free_space_limit",
                                          "free_space_shift_px", "through_support", "seen_surface",
                                          "seen_outside_mask", "outside_mask_limit", "mask_at_depth", "mask_uncovered",
-                                         "uncovered_mask_limit", "ms"});
+                                         "uncovered_mask_limit", "identity", "identity_objects", "identity_rival",
+                                         "identity_rival_oc_distance", "identity_rival_R", "identity_rival_t", "ms"});
   CHECK(j["cloud"] == "a.ply");
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) CHECK(j["R"][r][c].get<double>() == e.scene_from_model.R(r, c));
@@ -418,6 +419,10 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
     CHECK(j["rival_t"].is_null());
   }
   CHECK(j["free_space"].is_null());   // a ready-made cloud: no depth frame
+  CHECK(j["identity"].is_null());   // no other objects named
+  CHECK(j["identity_objects"] == 0);
+  CHECK(j["identity_rival"].is_null());
+  CHECK(j["identity_rival_R"].is_null());
   // Outlier indices are capped at kMaxListedOutliers; the count stays exact.
   PoseEstimate many = e;
   many.certificate.oc.outlier_indices.resize(kMaxListedOutliers + 5);

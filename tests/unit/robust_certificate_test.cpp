@@ -301,6 +301,20 @@ TEST_CASE("refusal: every failed part is named with its evidence, nothing when c
     CHECK(RefusalSummary(c).rfind("nd_global: the corrector moves the pose 0.031 away, where it leaves 4 points",
                                   0) == 0);
   }
+  SUBCASE("another known object certified too: identity names it, unchecked identity passes") {
+    Certificate c = whole;
+    REQUIRE(c.certified());
+    c.identity.checked = true;   // checked, nothing else certified
+    c.identity.objects_tried = 2;
+    CHECK(c.certified());
+    c.identity.passed = false;
+    c.identity.rival = "twin.json";
+    c.identity.rival_oc_distance = 0.004;
+    CHECK_FALSE(c.certified());
+    CHECK(RefusedBy(c) == Parts{CertificatePart::kIdentity});
+    CHECK(RefusalSummary(c) == "identity: twin.json is certified on the cloud too (its oc distance 0.004; 2 other "
+                               "objects tried)");
+  }
   SUBCASE("corrected keypoints off the posed model's: oc_keypoints only") {
     PointSet off = keypoints;
     off.col(1) += Eigen::Vector3d(0.0, 2.0 * eps_oc, 0.0);
@@ -328,7 +342,7 @@ TEST_CASE("refusal: every failed part is named with its evidence, nothing when c
   std::vector<std::string> names;   // distinct names for every part
   for (std::size_t k = 0; k < kCertificatePartCount; ++k) names.push_back(ToString(static_cast<CertificatePart>(k)));
   CHECK(names == std::vector<std::string>{"oc", "oc_keypoints", "free_space", "support", "mask", "uncovered",
-                                          "nd_sets", "nd_local", "nd_weak_motion", "nd_global"});
+                                          "nd_sets", "nd_local", "nd_weak_motion", "nd_global", "identity"});
 }
 
 TEST_CASE("local non-degeneracy: a box seen face-on fails, a corner view passes") {

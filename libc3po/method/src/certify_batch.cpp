@@ -158,6 +158,10 @@ PointSet LoadSourceCloud(const CloudSource& source, std::optional<SegmentCloud>*
 void CertifyBatchOptions::Check() const {
   pipeline.Check();
   if (auto_eps_oc) auto_eps_oc_options.Check();
+  for (const KnownObject& other : other_objects) other.Check();
+  if (auto_eps_oc && !other_objects.empty()) {
+    throw std::invalid_argument("CertifyBatchOptions: other_objects need an eps_oc given, not auto");
+  }
 }
 
 namespace {
@@ -245,6 +249,9 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
     }
     outcome.estimate =
         EstimateAndCertify(object, cloud, outcome.detected_keypoints, options.pipeline, free_space_test, judged);
+    if (!options.other_objects.empty() && outcome.estimate.certified()) {
+      outcome.estimate.certificate.identity = CheckIdentity(options.other_objects, cloud, view, judged);
+    }
     if (source.scene_from_model_truth && outcome.estimate.ok()) {
       outcome.truth_hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000),
                                                     *source.scene_from_model_truth, outcome.estimate.scene_from_model);

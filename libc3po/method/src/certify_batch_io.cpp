@@ -162,6 +162,20 @@ void AddFreeSpaceKeys(const FreeSpace& f, nlohmann::ordered_json* out) {
   line["uncovered_mask_limit"] = if_checked(f.mask_checked, f.uncovered_limit);
 }
 
+// Identity among known objects (identity_check.hpp); null when not checked.
+void AddIdentityKeys(const IdentityCheck& i, nlohmann::ordered_json* out) {
+  nlohmann::ordered_json& line = *out;
+  const bool rival = !i.rival.empty();
+  const nlohmann::ordered_json none(nullptr);
+  line["identity"] = i.checked ? nlohmann::ordered_json(i.passed) : none;
+  line["identity_objects"] = i.objects_tried;
+  line["identity_rival"] = rival ? nlohmann::ordered_json(i.rival) : none;
+  line["identity_rival_oc_distance"] = rival ? nlohmann::ordered_json(i.rival_oc_distance) : none;
+  const Pose& pose = i.rival_scene_from_model;
+  line["identity_rival_R"] = rival ? RotationJson(pose.R) : none;
+  line["identity_rival_t"] = rival ? nlohmann::ordered_json({pose.t(0), pose.t(1), pose.t(2)}) : none;
+}
+
 // Every key of an estimate, in the documented order.
 void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   AddPoseAndDecisionKeys(e, out);
@@ -169,6 +183,7 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   AddWeakMotionKeys(e.certificate.nd, out);
   AddRivalKeys(e.certificate.nd, out);
   AddFreeSpaceKeys(e.certificate.free_space, out);
+  AddIdentityKeys(e.certificate.identity, out);
   (*out)["ms"] = e.milliseconds;
 }
 

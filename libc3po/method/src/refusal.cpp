@@ -70,6 +70,10 @@ std::string Evidence(CertificatePart part, const Certificate& c) {
       return Format("a pose %.3g away (%.0f deg about axis %d) leaves %d points at >= eps_oc (rival distance %.3g)",
                     nd.global.rival_hausdorff, nd.global.rival_angle_deg, nd.global.rival_axis,
                     nd.global.rival_outliers, nd.global.rival_distance);
+    case CertificatePart::kIdentity:
+      return Format("%.200s is certified on the cloud too (its oc distance %.3g; %d other object%s tried)",
+                    c.identity.rival.c_str(), c.identity.rival_oc_distance, c.identity.objects_tried,
+                    c.identity.objects_tried == 1 ? "" : "s");
   }
   throw std::logic_error("unknown certificate part");
 }
@@ -88,6 +92,7 @@ const char* ToString(CertificatePart part) {
     case CertificatePart::kNdLocal: return "nd_local";
     case CertificatePart::kNdWeakMotion: return "nd_weak_motion";
     case CertificatePart::kNdGlobal: return "nd_global";
+    case CertificatePart::kIdentity: return "identity";
   }
   return "?";
 }
@@ -106,6 +111,7 @@ std::vector<CertificatePart> RefusedBy(const Certificate& c) {
     parts.push_back(nd.weak_motion_checked ? CertificatePart::kNdWeakMotion : CertificatePart::kNdLocal);
   }
   if (nd.global_checked && !nd.global.passed) parts.push_back(CertificatePart::kNdGlobal);
+  if (c.identity.checked && !c.identity.passed) parts.push_back(CertificatePart::kIdentity);
   return parts;
 }
 

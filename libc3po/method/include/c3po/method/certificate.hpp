@@ -110,14 +110,29 @@ struct NonDegeneracy {
   GlobalUniqueness global;
 };
 
+// Identity among known objects (identity_check.hpp; docs/method.md
+// "Identity among known objects"): every other object the user named was
+// estimated and certified on the same cloud by its own certifier; the check
+// fails when one of them is certified too (the cloud does not say which
+// object it shows). Not checked: passes (the paper's single-object setting).
+struct IdentityCheck {
+  bool checked = false;
+  bool passed = true;
+  int objects_tried = 0;
+  std::string rival;                   // the first other object certified on the cloud ("" = none)
+  double rival_oc_distance = 0.0;      // its budget distance (the (m+1)-th largest point distance)
+  Pose rival_scene_from_model;         // its certified pose
+};
+
 struct Certificate {
   ObservableCorrectness oc;
   NonDegeneracy nd;
   FreeSpace free_space;    // checked only for depth-image inputs (free_space.checked)
+  IdentityCheck identity;  // checked only when other objects are named (certify --other-objects)
   // The pose explains what was seen: oc and, for depth-image inputs, free
   // space (nd aside). Failing it refutes an estimate; a pseudo-label needs it.
   bool fits_observation() const { return oc.passed && !free_space.refutes(); }
-  bool certified() const { return fits_observation() && nd.passed; }
+  bool certified() const { return fits_observation() && nd.passed && identity.passed; }
 };
 
 ObservableCorrectness CheckObservableCorrectness(const ObjectModel& object, const PointSet& cloud,

@@ -21,6 +21,7 @@
 #include "c3po/io/segment.hpp"
 #include "c3po/method/auto_threshold.hpp"
 #include "c3po/method/detector.hpp"
+#include "c3po/method/identity_check.hpp"
 #include "c3po/method/pipeline.hpp"
 #include "c3po/object/object_model.hpp"
 
@@ -94,6 +95,11 @@ struct CertifyBatchOptions {
   // Also certify the plain registration T(ỹ) of the detected keypoints
   // (eval's "KeyPo" rows) besides the pipeline's estimate.
   bool also_uncorrected = false;
+  // Identity among known objects (identity_check.hpp): every pose certified
+  // is checked against these objects' certifiers on the same cloud
+  // (certificate.identity). Not with auto_eps_oc (its decision comes after
+  // the loop, when the frames are gone).
+  std::vector<KnownObject> other_objects;
   void Check() const;                 // throws std::invalid_argument / InputError
 };
 
@@ -177,7 +183,11 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   through_support (null without a support plane), seen_surface,
 //   seen_outside_mask, outside_mask_limit, mask_at_depth, mask_uncovered and
 //   uncovered_mask_limit (null without a mask; the mask tests,
-//   free_space.hpp); and last ms. Image-source lines also carry
+//   free_space.hpp); identity among known objects (identity_check.hpp):
+//   identity (null when not checked), identity_objects (tried),
+//   identity_rival (the other object certified too; null: none),
+//   identity_rival_oc_distance, identity_rival_R and identity_rival_t (null
+//   without a rival); and last ms. Image-source lines also carry
 //   gt_hausdorff after gt_t (Hausdorff(T*·B̂, T̂·B̂), metres) when the
 //   ground truth is known.
 constexpr std::size_t kMaxListedOutliers = 100;

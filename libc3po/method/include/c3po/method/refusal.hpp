@@ -25,16 +25,18 @@ enum class CertificatePart {
   kNdLocal,        // a motion the accepted points do not constrain (first order)
   kNdWeakMotion,   // the single unseen motion leads to a pose that fits too
   kNdGlobal,       // a far pose (rival) explains the points too
+  kIdentity,       // another known object is certified on the cloud too (identity_check.hpp)
 };
-inline constexpr std::size_t kCertificatePartCount = static_cast<std::size_t>(CertificatePart::kNdGlobal) + 1;
+inline constexpr std::size_t kCertificatePartCount = static_cast<std::size_t>(CertificatePart::kIdentity) + 1;
 
 // "oc", "oc_keypoints", "free_space", "support", "mask", "uncovered", "nd_sets", "nd_local",
-// "nd_weak_motion", "nd_global".
+// "nd_weak_motion", "nd_global", "identity".
 const char* ToString(CertificatePart part);
 
 // The failed parts in the order above; empty iff certificate.certified().
 // The weak-motion check replaces the local part when it ran; the global
-// search runs only when everything else passed, so it is then the only part.
+// search runs only when everything else passed, so it is then the only part;
+// so does the identity check (after the global search).
 std::vector<CertificatePart> RefusedBy(const Certificate& certificate);
 
 // The names of RefusedBy(estimate.certificate), or {"registration"} when the
