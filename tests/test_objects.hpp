@@ -1,5 +1,6 @@
 #pragma once
 // Small procedural meshes for unit tests (independent of the bundled objects).
+#include <string>
 #include <vector>
 
 #include "c3po/geometry/mesh.hpp"
@@ -40,6 +41,19 @@ inline Mesh MergeMeshes(const std::vector<Mesh>& parts) {
     t += part.triangles.cols();
   }
   return merged;
+}
+
+// A box of `size` centred at the origin, its corners as keypoints, eps_oc 1 cm
+// and delta_nd 8 mm (above the 20000-point sample's spacing, ~2 mm).
+inline ObjectModel BoxObject(const Eigen::Vector3d& size, const std::string& name = "box") {
+  ObjectSpec spec;
+  spec.name = name;
+  spec.keypoints = BoxMesh({0, 0, 0}, size).vertices;
+  spec.eps_oc = 0.01;
+  spec.delta_nd = 0.008;
+  ObjectModelOptions options;
+  options.sample_size = 20000;
+  return ObjectModel(spec, BoxMesh({0, 0, 0}, size), options);
 }
 
 // An asymmetric object: a 0.20 x 0.10 x 0.06 block, a 0.06-high tower on one

@@ -62,16 +62,7 @@ PipelineOptions Options(const ObjectModel& object) {
 }
 
 // A plain box of the given size centred at the origin (keypoints: its corners).
-ObjectModel PlainBox(const Eigen::Vector3d& size) {
-  ObjectSpec spec;
-  spec.name = "box";
-  spec.keypoints = test::BoxMesh({0, 0, 0}, size).vertices;
-  spec.eps_oc = 0.01;
-  spec.delta_nd = 0.008;
-  ObjectModelOptions model_options;
-  model_options.sample_size = 20000;
-  return ObjectModel(spec, test::BoxMesh({0, 0, 0}, size), model_options);
-}
+ObjectModel PlainBox(const Eigen::Vector3d& size) { return test::BoxObject(size); }
 
 // Points on the box part only (the bump's footprint on the top face removed):
 // every one of them also lies on the model turned by pi about z.

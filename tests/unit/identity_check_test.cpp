@@ -23,16 +23,7 @@ using namespace c3po;
 
 namespace {
 
-ObjectModel Box(const std::string& name, const Eigen::Vector3d& size) {
-  ObjectSpec spec;
-  spec.name = name;
-  spec.keypoints = test::BoxMesh({0, 0, 0}, size).vertices;
-  spec.eps_oc = 0.01;
-  spec.delta_nd = 0.008;
-  ObjectModelOptions options;
-  options.sample_size = 20000;
-  return ObjectModel(spec, test::BoxMesh({0, 0, 0}, size), options);
-}
+ObjectModel Box(const std::string& name, const Eigen::Vector3d& size) { return test::BoxObject(size, name); }
 
 // Returns the object's keypoints at a fixed pose, whatever the cloud.
 class PosedKeypoints : public Detector {
