@@ -31,11 +31,13 @@ std::optional<PoseEstimate> CertifiedEstimate(const KnownObject& other, const Po
     return std::nullopt;   // no keypoints, no pose: this object certifies nothing here
   }
   if (keypoints.cols() != other.object->num_keypoints()) return std::nullopt;
-  const CertificateOptions& certificate = other.pipeline.certificate;
+  PipelineOptions pipeline = other.pipeline;
+  pipeline.certificate.global.reestimate = false;   // the first estimate only (identity_check.hpp)
+  const CertificateOptions& certificate = pipeline.certificate;
   const std::optional<FreeSpaceTest> free_space =
       MakeFreeSpaceTest(*other.object, view, certificate.free_space, certificate.eps_oc);
-  PoseEstimate estimate = EstimateAndCertify(*other.object, cloud, keypoints, other.pipeline,
-                                             free_space ? &*free_space : nullptr, evidence);
+  PoseEstimate estimate =
+      EstimateAndCertify(*other.object, cloud, keypoints, pipeline, free_space ? &*free_space : nullptr, evidence);
   if (!estimate.certified()) return std::nullopt;
   return estimate;
 }

@@ -31,8 +31,11 @@ struct KnownObject {
 // Runs each other object's certifier on `cloud` (`evidence`: the cloud the
 // certificates judge when it is another, pipeline.hpp; `view`: the depth
 // frame for the free-space test, invalid for clouds) in order, and stops at
-// the first one certified. A detector that fails on the cloud certifies
-// nothing. Interrupted propagates.
+// the first one certified. Each certifier judges its detector's first
+// estimate: re-estimation (GlobalUniquenessOptions::reestimate) is off for
+// them, since restarting every other object about 13 axes on every segment
+// costs tens of seconds per pose (measured: docs/method.md). A detector
+// that fails on the cloud certifies nothing. Interrupted propagates.
 IdentityCheck CheckIdentity(const std::vector<KnownObject>& others, const PointSet& cloud, const DepthView& view,
                             const PointSet* evidence = nullptr);
 

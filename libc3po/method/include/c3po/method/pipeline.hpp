@@ -25,7 +25,7 @@ struct PoseEstimate {
   Pose scene_from_model;          // T̂
   CorrectorResult correction;     // iterations, costs (trivial without correction)
   Certificate certificate;
-  double milliseconds = 0.0;      // correction + certification time
+  double milliseconds = 0.0;      // correction + certification time (with the identity check, certify_batch.hpp)
   // Re-estimation (GlobalUniquenessOptions::reestimate): the estimate failed
   // oc or free space and the corrector restarted at the turn (axis, angle)
   // found the pose reported here (axis: a column of ReestimateAxes, 0-2 the
