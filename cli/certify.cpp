@@ -341,7 +341,7 @@ std::vector<CloudSource> CertifySources(const CertifyCommand& cmd, const Segment
   if (!cmd.data_dir.empty()) append(DatasetSources(ReadDataset(cmd.data_dir, /*ground_truth=*/false)));
   if (cmd.frame.given()) append(FrameSources(ResolveFrame(cmd.frame, "c3po certify"), segment));
   if (!cmd.bop.dir.empty()) {
-    const BopInstances listed = ListBopInstances(cmd.bop.dir, cmd.bop.options);
+    const BopInstances listed = ListBopInstancesWarning(cmd.bop.dir, cmd.bop.options, "c3po certify");
     if (listed.instances.empty()) {
       throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id) +
                                         (cmd.bop.options.detections_path.empty() ? "" : " in the detections") +

@@ -249,7 +249,7 @@ EvalData ReadEvalData(const EvalCommand& cmd, const SegmentOptions& segment, con
   std::string data_dir = cmd.data_dir;
   if (!cmd.bop.dir.empty()) {
     CheckSegmentOptions(segment, "c3po eval");
-    auto listed_shared = std::make_shared<const BopInstances>(ListBopInstances(cmd.bop.dir, cmd.bop.options));
+    auto listed_shared = std::make_shared<const BopInstances>(ListBopInstancesWarning(cmd.bop.dir, cmd.bop.options, "c3po eval"));
     const BopInstances& listed = *listed_shared;
     if (listed.instances.empty()) throw InputError(cmd.bop.dir, "no instances of obj_id " + std::to_string(cmd.bop.options.obj_id));
     // --shard by image, before the instances become a dataset.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iostream>
 #include <stdexcept>
 
 #include "c3po/base/atomic_file.hpp"
@@ -401,6 +402,12 @@ FrameInput ResolveFrame(const FrameFlags& flags, const std::string& command) {
     frame.camera = CameraFromIntrinsics(flags.intrinsics, *flags.depth_scale);
   }
   return frame;
+}
+
+BopInstances ListBopInstancesWarning(const std::string& dir, const BopOptions& options, const std::string& command) {
+  BopInstances listed = ListBopInstances(dir, options);
+  for (const std::string& warning : listed.warnings) std::cerr << command << ": warning: " << warning << "\n";
+  return listed;
 }
 
 void AddBopOptions(CLI::App& command, BopFlags* flags, BopDetections detections) {

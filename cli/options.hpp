@@ -178,6 +178,9 @@ struct BopFlags {
 };
 enum class BopDetections { kRefused, kAllowed };
 void AddBopOptions(CLI::App& command, BopFlags* flags, BopDetections detections);
+// ListBopInstances(dir, options), its warnings (unusable ground-truth poses,
+// reported as null) printed to stderr as "COMMAND: warning: ...".
+BopInstances ListBopInstancesWarning(const std::string& dir, const BopOptions& options, const std::string& command);
 
 // Camera inputs of the training commands (selftrain, train): one frame
 // (--depth/--mask/--camera) and/or BOP instances (--bop/--obj-id/--targets),

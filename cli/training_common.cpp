@@ -41,7 +41,7 @@ UnlabelledClouds LoadCameraClouds(CameraCloudFlags* flags, const ObjectModel& ob
     for (auto& s : FrameSources(ResolveFrame(flags->frame, command), flags->segment)) sources.push_back(s);
   }
   if (!flags->bop.dir.empty()) {
-    const BopInstances listed = ListBopInstances(flags->bop.dir, flags->bop.options);
+    const BopInstances listed = ListBopInstancesWarning(flags->bop.dir, flags->bop.options, command);
     if (listed.instances.empty()) {
       throw InputError(flags->bop.dir, "no instances of obj_id " + std::to_string(flags->bop.options.obj_id) +
                                            (flags->bop.options.targets_path.empty() ? "" : " among the targets"));
@@ -53,7 +53,7 @@ UnlabelledClouds LoadCameraClouds(CameraCloudFlags* flags, const ObjectModel& ob
       }
       BopOptions options = flags->bop.options;
       options.obj_id = other;
-      const BopInstances others = ListBopInstances(flags->bop.dir, options);
+      const BopInstances others = ListBopInstancesWarning(flags->bop.dir, options, command);
       if (others.instances.empty()) {
         throw InputError(flags->bop.dir, "no instances of obj_id " + std::to_string(other) + " (--add-obj-id)");
       }

@@ -6,6 +6,8 @@
 // depth_scale 1 vs 0.1, shards + merge; the real YCB-Video frames when present.
 #include <doctest/doctest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -19,6 +21,7 @@
 
 #include "c3po/base/atomic_file.hpp"
 #include "c3po/io/bop.hpp"
+#include "c3po/geometry/rotation.hpp"
 #include "c3po/base/error.hpp"
 #include "c3po/geometry/mesh.hpp"
 #include "c3po/io/mesh_io.hpp"
@@ -282,12 +285,73 @@ TEST_CASE("bad BOP folders: masks disagreeing with scene_gt.json, non-numbered s
   c3po::WriteFileAtomically(dir / "split/000001/scene_camera.json", cameras.dump());
   CHECK(InputErrorOf([&] { c3po::ListBopInstances(dir / "split", options); }) == dir / "split/000001/scene_camera.json: no entry for image 2");
 
-  CHECK(InputErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"obj_id": 1, "cam_R_m2c": [1,0,0,0,1,0,0,0,1.01], "cam_t_m2c": [0,0,1]}]})", "g.json"); })
-            .find("g.json: 1[0]: cam_R_m2c: not orthonormal (max |R^T R - I| = 0.0201") == 0);
-  CHECK(InputErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"obj_id": 1, "cam_R_m2c": [1,0,0,0,1,0,0,0,-1], "cam_t_m2c": [0,0,1]}]})", "g.json"); }) ==
-        "g.json: 1[0]: cam_R_m2c: determinant is -1 (a reflection, not a rotation)");
+  // A pose that is not one does not stop the listing: it is reported as null with the reason.
+  const auto unusable = c3po::ParseSceneGt(
+      R"({"1": [{"obj_id": 1, "cam_R_m2c": [1,0,0,0,1,0,0,0,1.01], "cam_t_m2c": [0,0,1]},
+                {"obj_id": 1, "cam_R_m2c": [1,0,0,0,1,0,0,0,-1], "cam_t_m2c": [0,0,1]},
+                {"obj_id": 2, "cam_R_m2c": [1,0,0,0,1,0,0,0,1], "cam_t_m2c": [0,"x",1]}]})",
+      "g.json");
+  REQUIRE(unusable.at(1).size() == 3);
+  CHECK_FALSE(unusable.at(1)[0].camera_from_model.has_value());
+  CHECK(unusable.at(1)[0].problem.find("g.json: 1[0]: cam_R_m2c: not orthonormal (max |R^T R - I| = 0.0201, tolerance 0.001)") == 0);
+  CHECK_FALSE(unusable.at(1)[1].camera_from_model.has_value());
+  CHECK(unusable.at(1)[1].problem == "g.json: 1[1]: cam_R_m2c: determinant is -1 (a reflection, not a rotation)");
+  CHECK(unusable.at(1)[2].obj_id == 2);
+  CHECK_FALSE(unusable.at(1)[2].camera_from_model.has_value());
+  CHECK(unusable.at(1)[2].problem.find("g.json: 1[2]: cam_t_m2c") == 0);
   CHECK(InputErrorOf([] { c3po::ParseSceneGt(R"({"x": []})", "g.json"); }) == "g.json: key 'x' is not an image id");
   CHECK(InputErrorOf([] { c3po::ParseSceneGt(R"({"1": [{"cam_R_m2c": [], "cam_t_m2c": []}]})", "g.json"); }) == "g.json: 1[0]: obj_id: missing");
+}
+
+TEST_CASE("scene_gt.json rotations as datasets ship them: within 1e-3 projected onto SO(3), beyond it reported null") {
+  // A rotation about z by 0.3 rad with each entry rounded to 3 decimals, as older annotation tools stored them
+  // (Linemod-Occluded's scene_gt.json reaches max |R^T R - I| = 2.9e-4).
+  Eigen::Matrix3d exact = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  Eigen::Matrix3d rounded = (exact * 1000.0).array().round().matrix() / 1000.0;
+  const double error = (rounded.transpose() * rounded - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  REQUIRE(error > c3po::kRotationTolerance);
+  REQUIRE(error < c3po::kDatasetRotationTolerance);
+  json doc;
+  std::vector<double> r;
+  for (int k = 0; k < 9; ++k) r.push_back(rounded(k / 3, k % 3));
+  doc["4"] = json::array({json{{"obj_id", 3}, {"cam_R_m2c", r}, {"cam_t_m2c", {10.0, -20.0, 800.0}}}});
+  const auto gt = c3po::ParseSceneGt(doc.dump(), "g.json");
+  const c3po::BopGroundTruth& entry = gt.at(4).at(0);
+  REQUIRE(entry.camera_from_model.has_value());
+  CHECK(entry.problem.empty());
+  const Eigen::Matrix3d& R = entry.camera_from_model->R;
+  CHECK((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK(R.determinant() > 0);
+  CHECK((R - exact).cwiseAbs().maxCoeff() < 1e-3);   // the projection stays within the rounding
+  CHECK((entry.camera_from_model->t - Eigen::Vector3d(0.010, -0.020, 0.8)).norm() < 1e-12);
+  // Beyond 1e-3 (entries rounded to 2 decimals): not a rotation, reported as null with the measured error.
+  const Eigen::Matrix3d coarse = (exact * 100.0).array().round().matrix() / 100.0;
+  const double coarse_error = (coarse.transpose() * coarse - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  REQUIRE(coarse_error > c3po::kDatasetRotationTolerance);
+  for (int k = 0; k < 9; ++k) r[static_cast<std::size_t>(k)] = coarse(k / 3, k % 3);
+  doc["4"][0]["cam_R_m2c"] = r;
+  const c3po::BopGroundTruth coarse_entry = c3po::ParseSceneGt(doc.dump(), "g.json").at(4).at(0);
+  CHECK_FALSE(coarse_entry.camera_from_model.has_value());
+  CHECK(coarse_entry.problem.find("not orthonormal") != std::string::npos);
+}
+
+TEST_CASE("a listed instance whose ground-truth pose is unusable: listed, pose null, one warning naming the file") {
+  c3po::test::TempDir dir("bop_bad_gt");
+  WriteScene(dir / "test/000003", 2, 1.0, 11);
+  const std::string gt_path = dir / "test/000003/scene_gt.json";
+  json gt_doc = json::parse(c3po::ReadFileToString(gt_path));
+  gt_doc["2"][0]["cam_R_m2c"] = {1, 0, 0, 0, 1, 0, 0, 0, 1.5};
+  c3po::WriteFileAtomically(gt_path, gt_doc.dump());
+  c3po::BopOptions options;
+  options.obj_id = 1;
+  const c3po::BopInstances listed = c3po::ListBopInstances(dir / "test", options);
+  REQUIRE(listed.instances.size() == 2);
+  CHECK(listed.instances[0].ground_truth.has_value());
+  CHECK_FALSE(listed.instances[1].ground_truth.has_value());
+  CHECK(listed.instances[1].ground_truth_problem.find(gt_path + ": 2[0]: cam_R_m2c: not orthonormal") == 0);
+  REQUIRE(listed.warnings.size() == 1);
+  CHECK(listed.warnings[0].find(gt_path + ": 2[0]: cam_R_m2c: not orthonormal") == 0);
+  CHECK(listed.warnings[0].find("its ground truth is reported as null") != std::string::npos);
 }
 
 TEST_CASE("models_info.json: diameters and symmetries") {

@@ -134,6 +134,7 @@ SegmentBenchmarkResult BenchmarkSegments(const SegmentBenchmarkOptions& options)
     result.max_sample_spacing = std::max(result.max_sample_spacing,
                                          std::sqrt(mesh.SurfaceArea() / options.model_sample));
     for (const BopInstance& instance : listed.instances) {
+      if (!instance.ground_truth) continue;   // its pose is unusable: listed.warnings says why
       ++result.instances;
       const std::unordered_map<std::int32_t, double> distance = DistanceByPixel(instance, tree);
       if (distance.empty()) continue;

@@ -6,17 +6,17 @@
 
 namespace c3po {
 
-std::optional<Eigen::Matrix3d> NearestRotation(const Eigen::Matrix3d& R, std::string* problem) {
+std::optional<Eigen::Matrix3d> NearestRotation(const Eigen::Matrix3d& R, std::string* problem, double tolerance) {
   constexpr double kProjectAbove = 1e-12;   // below this R is kept bit-exact
   if (!R.allFinite()) {
     *problem = "non-finite entries";
     return std::nullopt;
   }
   const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  if (error > kRotationTolerance) {
+  if (!(error <= tolerance)) {
     char text[128];
     std::snprintf(text, sizeof text, "not orthonormal (max |R^T R - I| = %.3g, tolerance %g)", error,
-                  kRotationTolerance);
+                  tolerance);
     *problem = text;
     return std::nullopt;
   }
@@ -26,7 +26,7 @@ std::optional<Eigen::Matrix3d> NearestRotation(const Eigen::Matrix3d& R, std::st
   }
   if (error <= kProjectAbove) return R;
   // Nearest rotation in the Frobenius norm; det stays +1 since R is within
-  // 1e-4 of a rotation.
+  // the tolerance (<= 0.1) of a rotation.
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
   return Eigen::Matrix3d(svd.matrixU() * svd.matrixV().transpose());
 }

@@ -2,6 +2,7 @@
 #include "c3po/io/bop_dataset.hpp"
 #include "c3po/io/dataset_writer.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <mutex>
 
@@ -20,9 +21,9 @@ std::string BopDatasetCloudName(const BopInstance& instance) {
 
 BopDatasetSummary WriteDatasetFromBop(const std::vector<BopInstance>& instances, const PointSet& model_keypoints,
                                   const SegmentOptions& options, const std::string& dir) {
-  for (const BopInstance& instance : instances) {
-    if (!instance.ground_truth) throw InputError(dir, "BOP instances without ground truth (detections) cannot make a dataset");
-  }
+  const bool any_truth = std::any_of(instances.begin(), instances.end(),
+                                     [](const BopInstance& instance) { return instance.ground_truth.has_value(); });
+  if (!any_truth) throw InputError(dir, "BOP instances without ground truth (detections) cannot make a dataset");
   DatasetWriter writer(dir);
   std::vector<std::string> skipped(instances.size());
   ParallelFor(0, static_cast<int>(instances.size()), [&](int i) {
@@ -30,6 +31,9 @@ BopDatasetSummary WriteDatasetFromBop(const std::vector<BopInstance>& instances,
     const BopInstance& instance = instances[static_cast<std::size_t>(i)];
     const std::string name = BopDatasetCloudName(instance);
     try {
+      if (!instance.ground_truth) {
+        throw InputError(name.substr(0, name.size() - 4), "no usable ground truth (" + instance.ground_truth_problem + ")");
+      }
       const SegmentCloud segment = LoadBopInstance(instance, options);
       RequireUsableSegment(segment, name.substr(0, name.size() - 4));
       DatasetEntry entry;

@@ -161,6 +161,8 @@ void ListGroundTruthInstances(const SceneListing& scene, const BopOptions& optio
       instance.mask_path = mask_dir + "/" + Id6(im_id) + "_" + Id6(static_cast<int>(gt_id)) + ".png";
       instance.camera = scene.CameraOf(im_id);
       instance.ground_truth = list[gt_id].camera_from_model;
+      instance.ground_truth_problem = list[gt_id].problem;
+      if (!instance.ground_truth) out->warnings.push_back(list[gt_id].problem + "; its ground truth is reported as null");
       out->instances.push_back(instance);
     }
   }
@@ -188,6 +190,26 @@ std::string FormatNumber(double value) {
   return text;
 }
 
+// One entry's cam_R_m2c / cam_t_m2c as a pose in metres; InputError naming the field.
+Pose GroundTruthPose(const json& entry, const std::string& name, const std::string& where) {
+  const json& r = Field(entry, "cam_R_m2c", name, where);
+  const json& t = Field(entry, "cam_t_m2c", name, where);
+  if (!r.is_array() || r.size() != 9) throw InputError(name, where + "cam_R_m2c: expected 9 numbers");
+  if (!t.is_array() || t.size() != 3) throw InputError(name, where + "cam_t_m2c: expected 3 numbers");
+  Eigen::Matrix3d R;
+  for (int k = 0; k < 9; ++k) R(k / 3, k % 3) = Number(r[static_cast<std::size_t>(k)], name, where + "cam_R_m2c");
+  std::string problem;
+  const auto rotation = NearestRotation(R, &problem, kDatasetRotationTolerance);
+  if (!rotation) throw InputError(name, where + "cam_R_m2c: " + problem);
+  Pose pose;
+  pose.R = *rotation;
+  for (int k = 0; k < 3; ++k) {
+    pose.t(k) = Number(t[static_cast<std::size_t>(k)], name, where + "cam_t_m2c") * kMetresPerMillimetre;
+  }
+  if (!pose.t.allFinite()) throw InputError(name, where + "cam_t_m2c: non-finite");
+  return pose;
+}
+
 }  // namespace
 
 std::map<int, std::vector<BopGroundTruth>> ParseSceneGt(const std::string& text, const std::string& name) {
@@ -203,18 +225,10 @@ std::map<int, std::vector<BopGroundTruth>> ParseSceneGt(const std::string& text,
       const std::string where = item.key() + "[" + std::to_string(i) + "]: ";
       BopGroundTruth instance;
       instance.obj_id = Id(Field(entry, "obj_id", name, where), name, where + "obj_id");
-      const json& r = Field(entry, "cam_R_m2c", name, where);
-      const json& t = Field(entry, "cam_t_m2c", name, where);
-      if (!r.is_array() || r.size() != 9) throw InputError(name, where + "cam_R_m2c: expected 9 numbers");
-      if (!t.is_array() || t.size() != 3) throw InputError(name, where + "cam_t_m2c: expected 3 numbers");
-      Eigen::Matrix3d R;
-      for (int k = 0; k < 9; ++k) R(k / 3, k % 3) = Number(r[static_cast<std::size_t>(k)], name, where + "cam_R_m2c");
-      std::string problem;
-      const auto rotation = NearestRotation(R, &problem);
-      if (!rotation) throw InputError(name, where + "cam_R_m2c: " + problem);
-      instance.camera_from_model.R = *rotation;
-      for (int k = 0; k < 3; ++k) {
-        instance.camera_from_model.t(k) = Number(t[static_cast<std::size_t>(k)], name, where + "cam_t_m2c") * kMetresPerMillimetre;
+      try {
+        instance.camera_from_model = GroundTruthPose(entry, name, where);
+      } catch (const InputError& e) {
+        instance.problem = e.what();
       }
       list.push_back(instance);
     }

@@ -25,12 +25,18 @@
 namespace c3po {
 
 // A ground-truth pose from scene_gt.json: camera_from_model in metres.
+// Ground truth is only ever reported (never used to certify), so a pose that is
+// not one -- a rotation not orthonormal within kDatasetRotationTolerance
+// (1e-3, rotation.hpp; projected onto SO(3) within it), non-finite or
+// missing numbers -- does not stop a run: camera_from_model is nullopt and
+// `problem` says why ("1[0]: cam_R_m2c: not orthonormal (...)").
 struct BopGroundTruth {
   int obj_id = 0;
-  Pose camera_from_model;
+  std::optional<Pose> camera_from_model;
+  std::string problem;
 };
-// scene_gt.json: im_id -> list (index = gt_id). Rotations: rotation.hpp
-// (orthonormal within 1e-4, projected onto SO(3)); InputError otherwise.
+// scene_gt.json: im_id -> list (index = gt_id). InputError for what the
+// listing needs: the document's structure, image keys, obj_id.
 std::map<int, std::vector<BopGroundTruth>> ParseSceneGt(const std::string& text, const std::string& name);
 
 struct BopDetection {
@@ -71,12 +77,16 @@ struct BopInstance {
   double score = 1.0;                        // detection score (1 for ground-truth masks)
   CameraInfo camera;
   std::optional<Pose> ground_truth;          // camera_from_model, metres (GT masks only)
+  std::string ground_truth_problem;          // why scene_gt.json's pose is not used (BopGroundTruth::problem)
 };
 
 struct BopInstances {
   std::vector<BopDetection> detections;      // kept alive for BopInstance::detection
   std::vector<BopInstance> instances;        // sorted by scene_id, im_id, gt_id
   std::vector<std::string> scene_dirs;
+  // One line per listed instance whose ground-truth pose is not used
+  // ("DIR/scene_gt.json: 3[0]: cam_R_m2c: ...; its ground truth is reported as null").
+  std::vector<std::string> warnings;
 };
 
 // Lists the instances of options.obj_id under `dir` (a scene or a split).

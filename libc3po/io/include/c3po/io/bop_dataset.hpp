@@ -20,9 +20,10 @@ struct BopDatasetSummary {
 std::string BopDatasetCloudName(const BopInstance& instance);
 
 // Writes `dir` (DatasetWriter: atomic, replaces an existing dataset). Clouds
-// are named by BopDatasetCloudName. Instances without ground truth (from
-// detections) are an InputError("dir", ...); instances whose segment is
-// unusable (RequireUsableSegment) are skipped and listed.
+// are named by BopDatasetCloudName. Instances that all lack ground truth (from
+// detections) are an InputError("dir", ...); an instance whose scene_gt.json
+// pose is unusable (BopInstance::ground_truth_problem) or whose segment is
+// unusable (RequireUsableSegment) is skipped and listed.
 BopDatasetSummary WriteDatasetFromBop(const std::vector<BopInstance>& instances, const PointSet& model_keypoints,
                                   const SegmentOptions& options, const std::string& dir);
 
