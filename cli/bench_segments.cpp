@@ -52,6 +52,7 @@ int RunSegmentsBench(const SegmentsBenchCommand& cmd) {
     for (double step : ParseList<double>(cmd.steps, "--depth-steps")) {
       for (double plane : ParseList<double>(cmd.planes, "--support-planes")) {
         SegmentOptions variant;
+        variant.erode_mask_metres = 0.0;
         variant.erode_mask = erode;
         variant.max_relative_depth_step = step;
         variant.support_plane_distance = plane;

@@ -318,10 +318,50 @@ void AddThreadsOption(CLI::App& command, int* threads, const std::string& what) 
 }
 
 
+void SetMaskErosion(const std::string& text, SegmentOptions* options) {
+  const auto refuse = [&text]() -> CLI::ValidationError {
+    return CLI::ValidationError("--erode-mask", "'" + text + "' must be a width (3mm, 0.5cm, 0.003m) or pixels (4, 4px) in [0, 1000]");
+  };
+  const bool pixels = text.size() > 2 && text.compare(text.size() - 2, 2, "px") == 0;
+  const std::string number = pixels ? text.substr(0, text.size() - 2) : text;
+  char* end = nullptr;
+  const long count = std::strtol(number.c_str(), &end, 10);
+  if (!number.empty() && *end == '\0') {
+    if (count < 0 || count > 1000) throw refuse();
+    options->erode_mask = static_cast<int>(count);
+    options->erode_mask_metres = 0.0;
+    return;
+  }
+  if (pixels || (text.back() != 'm')) throw refuse();   // a width needs its unit (mm, cm, m)
+  double width = 0.0;
+  try {
+    width = ParseThreshold(text, 0.0, "--erode-mask");
+  } catch (const InputError&) {
+    throw refuse();
+  }
+  if (width > 1.0) throw refuse();
+  options->erode_mask = 0;
+  options->erode_mask_metres = width;
+}
+
+std::string DescribeMaskErosion(const SegmentOptions& options) {
+  char text[64];
+  if (options.erode_mask_metres > 0.0) {
+    std::snprintf(text, sizeof text, "%g mm", options.erode_mask_metres * 1000.0);
+  } else {
+    std::snprintf(text, sizeof text, "%d px", options.erode_mask);
+  }
+  return text;
+}
+
 void AddSegmentOptions(CLI::App& command, SegmentOptions* options) {
-  command.add_option("--erode-mask", options->erode_mask,
-                     "Erode masks by K pixels for the estimate (the detector and the corrector; 0 = off)")
-      ->capture_default_str();
+  command
+      .add_option_function<std::string>(
+          "--erode-mask", [options](const std::string& text) { SetMaskErosion(text, options); },
+          "Erode masks for the estimate (the detector and the corrector) by a width at the segment's depth (3mm, "
+          "0.5cm: the same band on every camera) or by K pixels (4, 4px); 0 = off. Lowered where it would leave "
+          "less than half of the segment (default 3mm)")
+      ->type_name("W");
   command.add_option("--depth-edge", options->max_relative_depth_step,
                      "Drop pixels whose depth differs from a neighbour's by more than this fraction of their "
                      "depth (0 = off)")
@@ -364,7 +404,8 @@ void ResolveEvidence(const std::string& flag, const CertificateOptions& certific
 }
 
 std::string DescribeEvidence(const SegmentOptions& segment) {
-  if (segment.evidence_erode_mask < 0 || segment.evidence_erode_mask == segment.erode_mask) return "";
+  const bool same_pixels = segment.erode_mask_metres == 0.0 && segment.evidence_erode_mask == segment.erode_mask;
+  if (segment.evidence_erode_mask < 0 || same_pixels) return "";
   if (segment.evidence_erode_mask == 0) return "; evidence: every mask point";
   return "; evidence: mask eroded by " + std::to_string(segment.evidence_erode_mask) + " px";
 }

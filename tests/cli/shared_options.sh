@@ -159,8 +159,8 @@ grep -q "centring" c.out && fail "certify without --no-centre mentions centring:
 # counts, and what is certified lies within D + eps_oc of the truth (the
 # loosened bound, docs/method.md). The JSON lines carry D, the summary names it.
 # (-o writes the JSON lines; stdout keeps the summary.)
-"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o rd0.jsonl > /dev/null 2>&1 || true
-"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --rival-distance 15%d -o rd.jsonl > rd.out 2>&1 || true
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 4 -o rd0.jsonl > /dev/null 2>&1 || true
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 4 --rival-distance 15%d -o rd.jsonl > rd.out 2>&1 || true
 grep -q "global rivals [0-9]* beyond 0.2598" rd.out || fail "certify --rival-distance: summary $(grep -o 'global rivals[^,]*' rd.out)"
 python3 - "$NOSETS" <<'PY' || fail "--rival-distance does not act on the rival search"
 import json, sys
@@ -245,6 +245,55 @@ for l in open('c.jsonl'):
 }
 mask_option --outside-mask-fraction outside_mask_limit 0.05 mask seen_outside_mask free_space_measured
 mask_option --uncovered-mask-fraction uncovered_mask_limit 0.035 uncovered mask_uncovered mask_at_depth
+# --erode-mask: a width at the segment's depth (default 3mm) or pixels. Every
+# frame's k (erode_pixels) is round(f * w / median depth) lowered by the
+# half-segment floor, so it never exceeds the width's pixels; pixels are taken
+# as given (or lowered by the floor); 0 = off; malformed widths are one-line errors.
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o e_default.jsonl > /dev/null 2>&1 || true
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 3mm -o e_3mm.jsonl > /dev/null 2>&1 || true
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 6px -o e_6px.jsonl > /dev/null 2>&1 || true
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 0 -o e_0.jsonl > /dev/null 2>&1 || true
+python3 - "$SRC" <<'PY' || fail "--erode-mask: erode_pixels not as the width, pixels or 0 give"
+import json
+rows = lambda f: [json.loads(l) for l in open(f)]
+default, mm3, px6, off = rows('e_default.jsonl'), rows('e_3mm.jsonl'), rows('e_6px.jsonl'), rows('e_0.jsonl')
+cams = json.load(open('bop/000000/scene_camera.json'))
+assert len(default) == 2 and [r['erode_pixels'] for r in default] == [r['erode_pixels'] for r in mm3]
+for r in default:
+    assert 0 <= r['erode_pixels'] <= 1000
+for r in px6:
+    assert 0 < r['erode_pixels'] <= 6
+    assert r['removed_erosion'] >= max(o['removed_erosion'] for o in off)
+for r in off:
+    assert r['erode_pixels'] == 0 and r['removed_erosion'] == 0
+PY
+for w in 3.5 abc -2 5km 2000 0.5px; do
+  bad_value --erode-mask "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask "$w"
+done
+bad_value --erode-mask "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 2m
+# Ground truth that is not a rotation (here |R^T R - I| = 0.21) never stops a
+# certify run: the instance's gt_ fields are null and one warning names the file.
+cp -r bop bop_badgt
+python3 - <<'PY'
+import json
+p = 'bop_badgt/000000/scene_gt.json'
+gt = json.load(open(p))
+first = sorted(gt, key=int)[0]
+gt[first][0]['cam_R_m2c'] = [1, 0, 0, 0, 1, 0, 0, 0, 1.1]
+json.dump(gt, open(p, 'w'))
+PY
+"$C3PO" certify "$NOSETS" --bop bop_badgt --obj-id 3 --detector svd -o g.jsonl > g.out 2> g.err
+status=$?
+[ $status -le 1 ] || fail "certify with an unusable ground-truth pose exited $status: $(cat g.err)"
+grep -q "c3po certify: warning: .*bop_badgt/000000/scene_gt.json: .*cam_R_m2c: not orthonormal.*reported as null" g.err \
+  || fail "no ground-truth warning: $(cat g.err)"
+python3 - <<'PY' || fail "certify with an unusable ground-truth pose: gt fields not null / others missing"
+import json
+rows = [json.loads(l) for l in open('g.jsonl')]
+assert len(rows) == 2
+assert rows[0].get('gt_hausdorff') is None and 'R' in rows[0]
+assert rows[1].get('gt_hausdorff') is not None
+PY
 if [ $pointnet -eq 1 ]; then
   "$C3PO" selftrain "$NOSETS" --model cube.model --bop bop --obj-id 3 --copies 2 --epochs 1 -o self_bop.model     > s.out 2>&1 || fail "selftrain --bop exited $?: $(tail -1 s.out)"
   [ "$(summary s.out)" == "m = 2%, robust loss = tls" ] || fail "selftrain --bop defaults: '$(summary s.out)'"

@@ -17,6 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (std::size_t i = 0; i < depth.z.size(); i += 3) mask.inside[i] = 1;
     const c3po::PinholeCamera camera{500.0, 500.0, depth.width / 2.0, depth.height / 2.0};
     c3po::SegmentOptions options;
+    options.erode_mask_metres = 0.0;
     options.erode_mask = 1;
     const c3po::SegmentCloud s = c3po::ExtractSegment(depth, mask, camera, options, "fuzz.npy");
     if (s.mask_pixels != s.no_depth + s.removed_by_erosion + s.removed_by_discontinuity + s.removed_by_plane +

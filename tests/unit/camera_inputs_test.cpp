@@ -33,6 +33,7 @@ Mask FullMask(int w, int h) { return Mask{w, h, std::vector<std::uint8_t>(static
 
 c3po::SegmentOptions NoPreprocessing() {
   c3po::SegmentOptions options;
+  options.erode_mask_metres = 0.0;
   options.erode_mask = 0;
   options.max_relative_depth_step = 0.0;
   options.support_plane_distance = 0.0;
@@ -225,6 +226,8 @@ TEST_CASE("preprocessing: counts add up, the discontinuity filter equals brute f
   for (int erode : {0, 1, 2}) {
     for (double step : {0.0, 0.02, 0.1}) {
       c3po::SegmentOptions options;
+      options.erode_mask_metres = 0.0;   // pixel widths, no floor: the oracle erodes by exactly `erode`
+      options.min_eroded_fraction = 0.0;
       options.erode_mask = erode;
       options.max_relative_depth_step = step;
       options.support_plane_distance = 0.0;   // the support plane has its own test
@@ -465,7 +468,64 @@ TEST_CASE("unusable segments: no pixels, no depth, too few points left") {
   depth.z.assign(36, 1.0f);
   Mask dot = empty;
   dot.inside[14] = 1;
-  CHECK(message(dot, depth).find("m.png: only 0 points left after preprocessing") == 0);   // eroded away
+  // A one-pixel segment: the default erosion (3 mm = 2 px at 1 m) would remove all of it, so the floor
+  // (min_eroded_fraction) keeps it uneroded; without the floor it is eroded away. (The flat frame would be one
+  // support plane taking the dot: that step is off here.)
+  c3po::SegmentOptions floor;
+  floor.support_plane_distance = 0.0;
+  c3po::SegmentOptions no_floor = floor;
+  no_floor.min_eroded_fraction = 0.0;
+  const auto error_with = [&](const c3po::SegmentOptions& options) {
+    return InputErrorOf([&] { c3po::RequireUsableSegment(c3po::ExtractSegment(depth, dot, kCamera, options, "m.png"), "m.png"); });
+  };
+  CHECK(error_with(floor) == "m.png: only 1 points left after preprocessing (1 mask pixels, 0 without depth, 0 eroded, "
+                             "0 on depth edges, 0 on the support plane)");
+  CHECK(error_with(no_floor) == "m.png: only 0 points left after preprocessing (1 mask pixels, 0 without depth, 1 eroded, "
+                                "0 on depth edges, 0 on the support plane)");
+}
+
+TEST_CASE("metric erosion: k = round(f w / median depth), the same band in metres at any distance and focal length") {
+  // A flat 120 x 90 px mask at depth z; a 3 mm band is round(f * 0.003 / z) px (at most 11 here, which keeps
+  // 98 x 68 px, more than half: the floor does not act).
+  const int w = 160, h = 120;
+  Mask mask{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h, 0)};
+  for (int v = 15; v < 105; ++v) for (int u = 20; u < 140; ++u) mask.inside[static_cast<std::size_t>(v) * w + u] = 1;
+  for (double z : {0.3, 0.6, 1.2}) {
+    for (double f : {380.0, 572.0, 1067.0}) {
+      CAPTURE(z);
+      CAPTURE(f);
+      const DepthImage depth{w, h, std::vector<float>(static_cast<std::size_t>(w) * h, static_cast<float>(z))};
+      const c3po::PinholeCamera camera{f, f, 80.0, 60.0};
+      c3po::SegmentOptions options;   // 3 mm, floor 0.5
+      options.max_points = 0;
+      options.support_plane_distance = 0.0;
+      const int expected = static_cast<int>(std::round(f * 0.003 / z));
+      CHECK(c3po::ErosionPixels(depth, mask, camera, options) == expected);
+      const c3po::SegmentCloud s = c3po::ExtractSegment(depth, mask, camera, options, "x");
+      CHECK(s.erode_pixels == expected);
+      // Brute force: the eroded rectangle keeps (120 - 2k)(90 - 2k) pixels (the flat depth has no edges inside).
+      CHECK(s.cloud.cols() == (120 - 2 * expected) * (90 - 2 * expected));
+      CHECK(s.removed_by_erosion == static_cast<std::size_t>(120 * 90 - s.cloud.cols()));
+    }
+  }
+  // The floor: a 6 px strip would be eroded away by 11 px (f 1067 at 0.3 m); k is lowered to the largest value
+  // keeping half of it (6 - 2k >= 3: k = 1), whatever the width asked.
+  Mask strip{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h, 0)};
+  for (int v = 20; v < 26; ++v) for (int u = 5; u < 75; ++u) strip.inside[static_cast<std::size_t>(v) * w + u] = 1;
+  const DepthImage near{w, h, std::vector<float>(static_cast<std::size_t>(w) * h, 0.3f)};
+  c3po::SegmentOptions options;
+  CHECK(c3po::ErosionPixels(near, strip, c3po::PinholeCamera{1067.0, 1067.0, 40.0, 30.0}, options) == 1);
+  options.erode_mask_metres = 0.0;
+  options.erode_mask = 5;
+  CHECK(c3po::ErosionPixels(near, strip, c3po::PinholeCamera{1067.0, 1067.0, 40.0, 30.0}, options) == 1);
+  options.min_eroded_fraction = 0.0;
+  CHECK(c3po::ErosionPixels(near, strip, c3po::PinholeCamera{1067.0, 1067.0, 40.0, 30.0}, options) == 5);
+  // The median depth, not the mean: a few far pixels do not change k.
+  DepthImage mixed = near;
+  for (int u = 30; u < 40; ++u) mixed.z[static_cast<std::size_t>(50) * w + u] = 5.0f;
+  options = c3po::SegmentOptions{};
+  CHECK(c3po::ErosionPixels(mixed, mask, c3po::PinholeCamera{1067.0, 1067.0, 40.0, 30.0}, options) ==
+        static_cast<int>(std::round(1067.0 * 0.003 / 0.3)));
 }
 
 TEST_CASE("COCO RLE: compressed == uncompressed == brute-force pixels (column-major runs)") {
@@ -639,6 +699,8 @@ TEST_CASE("the certificate's evidence: the same steps with its own erosion, the 
         CAPTURE(evidence_erode);
         CAPTURE(max_points);
         c3po::SegmentOptions options;
+        options.erode_mask_metres = 0.0;
+        options.min_eroded_fraction = 0.0;
         options.erode_mask = erode;
         options.evidence_erode_mask = evidence_erode;
         options.max_points = max_points;

@@ -754,6 +754,7 @@ TEST_CASE("soundness on a table: the segmenter's plane filters rivals, yet no ce
       mask.inside[i] = scene.label[i] == 0;
     }
     SegmentOptions segment_options;
+    segment_options.erode_mask_metres = 0.0;
     segment_options.erode_mask = 0;
     segment_options.max_points = 3000;
     const SegmentCloud segment = ExtractSegment(depth, mask, camera, segment_options, "table scene");

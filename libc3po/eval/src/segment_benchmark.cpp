@@ -48,6 +48,7 @@ std::vector<int> ObjectIdsInGroundTruth(const std::string& bop_dir) {
 // Distance of every valid mask pixel's point (no preprocessing) to the ground-truth-posed model.
 std::unordered_map<std::int32_t, double> DistanceByPixel(const BopInstance& instance, const PointTree& model) {
   SegmentOptions all;
+  all.erode_mask_metres = 0.0;
   all.erode_mask = 0;
   all.max_relative_depth_step = 0.0;
   all.support_plane_distance = 0.0;

@@ -86,6 +86,12 @@ std::vector<int> MaskDistance(const Mask& mask) {
 
 void SegmentOptions::Check() const {
   if (erode_mask < 0 || erode_mask > 1000) throw std::invalid_argument("erode_mask must be in [0, 1000]");
+  if (!(std::isfinite(erode_mask_metres) && erode_mask_metres >= 0.0 && erode_mask_metres <= 1.0)) {
+    throw std::invalid_argument("erode_mask_metres must be in [0, 1] m");
+  }
+  if (!(min_eroded_fraction >= 0.0 && min_eroded_fraction < 1.0)) {
+    throw std::invalid_argument("min_eroded_fraction must be in [0, 1)");
+  }
   if (evidence_erode_mask < -1 || evidence_erode_mask > 1000) {
     throw std::invalid_argument("evidence_erode_mask must be -1 (none) or in [0, 1000]");
   }
@@ -115,7 +121,32 @@ bool OnDepthDiscontinuity(const DepthImage& depth, int u, int v, double step) {
   return false;
 }
 
+// Mask pixels with a valid depth.
+std::size_t WithDepth(const DepthImage& depth, const Mask& mask) {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < mask.inside.size(); ++i) count += mask.inside[i] != 0 && DepthImage::Valid(depth.z[i]);
+  return count;
+}
+
 }  // namespace
+
+int ErosionPixels(const DepthImage& depth, const Mask& mask, const PinholeCamera& camera, const SegmentOptions& options) {
+  std::vector<float> z;
+  for (std::size_t i = 0; i < mask.inside.size(); ++i) {
+    if (mask.inside[i] != 0 && DepthImage::Valid(depth.z[i])) z.push_back(depth.z[i]);
+  }
+  if (z.empty()) return 0;
+  int k = options.erode_mask;
+  if (options.erode_mask_metres > 0.0) {
+    const auto middle = z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2);
+    std::nth_element(z.begin(), middle, z.end());
+    const double f = 0.5 * (camera.fx + camera.fy);
+    k = static_cast<int>(std::min(1000.0, std::round(f * options.erode_mask_metres / static_cast<double>(*middle))));
+  }
+  const double keep = options.min_eroded_fraction * static_cast<double>(z.size());
+  while (k > 0 && options.min_eroded_fraction > 0.0 && static_cast<double>(WithDepth(depth, ErodeMask(mask, k))) < keep) --k;
+  return k;
+}
 
 SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const PinholeCamera& camera,
                             const SegmentOptions& options, const std::string& name) {
@@ -128,8 +159,9 @@ SegmentCloud ExtractSegment(const DepthImage& depth, const Mask& mask, const Pin
   result.depth = std::make_shared<const DepthImage>(depth);
   result.mask = std::make_shared<const Mask>(mask);
   result.camera = camera;
-  const Mask eroded = ErodeMask(mask, options.erode_mask);
-  const bool own_evidence = options.evidence_erode_mask >= 0 && options.evidence_erode_mask != options.erode_mask;
+  result.erode_pixels = ErosionPixels(depth, mask, camera, options);
+  const Mask eroded = ErodeMask(mask, result.erode_pixels);
+  const bool own_evidence = options.evidence_erode_mask >= 0 && options.evidence_erode_mask != result.erode_pixels;
   const Mask evidence_eroded = own_evidence ? ErodeMask(mask, options.evidence_erode_mask) : Mask{};
   std::optional<SupportPlaneFit> support;
   if (options.support_plane_distance > 0.0) {

@@ -35,6 +35,7 @@ nlohmann::ordered_json SourceKeys(const CloudSource& source, const CloudOutcome&
     line["pixels"] = s.mask_pixels;
     line["no_depth"] = s.no_depth;
     line["removed_erosion"] = s.removed_by_erosion;
+    line["erode_pixels"] = s.erode_pixels;
     line["removed_discontinuity"] = s.removed_by_discontinuity;
     line["removed_plane"] = s.removed_by_plane;
     line["removed_subsampling"] = s.removed_by_subsampling;

@@ -4,7 +4,15 @@
 // (docs/camera_inputs.md gives the measurements behind the defaults):
 //  1. mask pixels without depth are skipped (counted);
 //  2. mask erosion by k pixels (square (2k+1)^2 structuring element; the
-//     image border does not erode) drops pixels bleeding onto the background;
+//     image border does not erode) drops pixels bleeding onto the background.
+//     The bleed is a band of the scene (depth-to-colour registration, the
+//     sensor's smoothing of depth edges), so k is set from a metric width w
+//     at the segment's median depth z̃: k = round(f w / z̃) (f = (fx + fy)/2),
+//     the same band on every camera and at every distance; a width in pixels
+//     is also accepted. k is then lowered until the eroded mask keeps at least
+//     `min_eroded_fraction` of the mask's pixels with depth: a segment whose
+//     rim is most of it (a thin strip of an occluded object) would be eroded
+//     away, leaving the estimate too few points to be right;
 //  3. depth-discontinuity filter: a pixel is dropped when an 8-neighbour with
 //     depth differs from it by more than `max_relative_depth_step` x its depth
 //     ("flying pixels" interpolated across depth edges);
@@ -52,7 +60,12 @@ Mask ErodeMask(const Mask& mask, int k);
 std::vector<int> MaskDistance(const Mask& mask);
 
 struct SegmentOptions {
-  int erode_mask = 4;                      // pixels; 0 = off
+  // Step 2's width: erode_mask_metres > 0 sets it at the segment's depth (the
+  // default, 3 mm: 4 px at 0.8 m on the YCB-Video Xtion, f = 1067 px);
+  // otherwise erode_mask pixels (0 with erode_mask_metres 0 = off).
+  double erode_mask_metres = 0.003;
+  int erode_mask = 0;                      // pixels, when erode_mask_metres == 0
+  double min_eroded_fraction = 0.5;        // in [0, 1); 0 = no floor
   int evidence_erode_mask = -1;            // pixels, for SegmentCloud::evidence; -1 = no evidence of its own
   double max_relative_depth_step = 0.02;   // 0 = filter off
   double support_plane_distance = 0.01;    // metres; 0 = off
@@ -60,12 +73,19 @@ struct SegmentOptions {
   void Check() const;                      // throws std::invalid_argument
 };
 
+// Step 2's k for a mask on a depth image (see above): from the metric width
+// at the mask's median valid depth (or the pixel count), lowered until the
+// eroded mask keeps min_eroded_fraction of the mask's pixels with depth; 0
+// when the mask has no pixel with depth.
+int ErosionPixels(const DepthImage& depth, const Mask& mask, const PinholeCamera& camera, const SegmentOptions& options);
+
 struct SegmentCloud {
   PointSet cloud;                          // camera frame, metres
   std::vector<std::int32_t> pixels;        // pixel index (v * width + u) of each point
   std::size_t mask_pixels = 0;
   std::size_t no_depth = 0;                // mask pixels without a measurement
   std::size_t removed_by_erosion = 0;      // with depth, removed by step 2
+  int erode_pixels = 0;                    // step 2's k for this segment (ErosionPixels)
   std::size_t removed_by_discontinuity = 0;
   std::size_t removed_by_plane = 0;        // step 4
   std::size_t removed_by_subsampling = 0;
