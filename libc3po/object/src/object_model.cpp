@@ -72,13 +72,17 @@ ObjectModel::ObjectModel(ObjectSpec spec, Mesh mesh, const ObjectModelOptions& o
   tree_ = std::make_shared<const PointTree>(std::move(sample.points));
   diameter_ = mesh_.Diameter();
   // Crease flags: a sample point whose 8 nearest sample neighbours include a
-  // normal more than 30 degrees off its own lies at an edge or crease, where
-  // the nearest sample of a nearby point may carry the other side's normal.
+  // normal more than 30 degrees off its own line lies at an edge or crease,
+  // where the nearest sample of a nearby point may carry the other side's
+  // normal. A normal opposite to its own (within 30 degrees) is the other face
+  // of a thin wall (a bowl, a mug): a point-to-plane row is the same for n and
+  // -n (local_nondegeneracy.hpp), so that is no crease -- else every sample of
+  // a wall thinner than the sample spacing would be flagged.
   auto crease = std::make_shared<std::vector<char>>(tree_->points().cols(), 0);
   const double cos_limit = std::cos(30.0 * M_PI / 180.0);
   for (Eigen::Index i = 0; i < tree_->points().cols(); ++i) {
     for (const auto& nb : tree_->KNearest(tree_->points().col(i), 9)) {
-      if (normals_->col(nb.index).dot(normals_->col(i)) < cos_limit) {
+      if (std::abs(normals_->col(nb.index).dot(normals_->col(i))) < cos_limit) {
         (*crease)[i] = 1;
         break;
       }

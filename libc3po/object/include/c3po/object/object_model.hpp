@@ -57,7 +57,8 @@ class ObjectModel {
   // Mesh triangle each sample point lies on.
   const std::vector<int>& sample_triangles() const { return *triangles_; }
   // 1 where a sample point lies at an edge or crease of the mesh (a neighbour
-  // among its 8 nearest has a normal > 30 degrees off): its normal does not
+  // among its 8 nearest has a normal > 30 degrees off its own line; the
+  // opposite face of a thin wall is not a crease): its normal does not
   // represent nearby points (local non-degeneracy skips them).
   const std::vector<char>& sample_on_crease() const { return *crease_; }
   double diameter() const { return diameter_; }
