@@ -101,10 +101,14 @@ void AddRobustOptions(CLI::App& command, RobustFlags* flags) {
                    "A pose refused only by rivals within twice the rival distance stays refused (by default the "
                    "centre of it and its rivals is certified instead when it passes everything and lies within the "
                    "rival distance of all of them)");
+  command.add_option("--tolerance", flags->tolerance,
+                     "The accuracy you need: a certified pose lies within it of the truth (Hausdorff, + sensor "
+                     "noise), as far as the rival search reaches; a second fit farther than the tolerance - eps_oc "
+                     "refuses the pose. A distance (2cm, 0.02) or a fraction of d (10%d); default 10%d, at least "
+                     "3*eps_oc (JSON certified_bound; docs/method.md \"Tolerance\")");
   command.add_option("--rival-distance", flags->rival_distance,
-                     "A second pose that fits counts as a rival (fails nd) only beyond this Hausdorff distance "
-                     "of the estimate: a distance (2cm, 0.02) or a fraction of d (10%d); default 2*eps_oc. "
-                     "Larger: the certified bound loosens to about this distance + eps_oc (docs/method.md)");
+                     "Expert, instead of --tolerance: a second fit counts as a rival beyond this Hausdorff distance "
+                     "of the estimate (default tolerance - eps_oc); the certified bound is this + eps_oc");
   command.add_option("--global-steps", flags->global_steps,
                      "Rival starts: rotations by k*360/N deg about each principal axis (N even, default 4), "
                      "half-turns about the 10 diagonals of the principal frame, and the estimate itself");
@@ -194,8 +198,20 @@ void ResolveRobust(const RobustFlags& flags, InputKind input, const ObjectModel&
   const bool reestimate_by_default = input == InputKind::kCameraFrames && flags.reestimate_camera_frames;
   certificate->global.reestimate = !flags.no_reestimate && (flags.reestimate || reestimate_by_default);
   certificate->global.steps = flags.global_steps;
+  if (!flags.tolerance.empty() && !flags.rival_distance.empty()) {
+    throw InputError("--tolerance", "give --tolerance or --rival-distance, not both (the rival distance is the tolerance - eps_oc)");
+  }
   certificate->global.rival_distance =
       flags.rival_distance.empty() ? 0.0 : ParseThreshold(flags.rival_distance, object.diameter(), "--rival-distance");
+  certificate->global.tolerance =
+      flags.tolerance.empty() ? 0.0 : ParseThreshold(flags.tolerance, object.diameter(), "--tolerance");
+  if (certificate->global.tolerance > 0.0 && certificate->eps_oc > 0.0 &&
+      !(certificate->global.tolerance > certificate->eps_oc)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "'%s' = %g must exceed eps_oc = %g: no certificate is more precise than its own fit",
+                  flags.tolerance.c_str(), certificate->global.tolerance, certificate->eps_oc);
+    throw InputError("--tolerance", text);
+  }
   certificate->global.reestimate_steps = flags.reestimate_steps;
   if (flags.reestimate_steps < 2 || flags.reestimate_steps > 36 || flags.reestimate_steps % 2 != 0) {
     throw InputError("--reestimate-steps", std::to_string(flags.reestimate_steps) + " must be even and in [2, 36]");
@@ -225,6 +241,10 @@ std::string DescribeRobust(const CertificateOptions& certificate, const Correcto
       char beyond[48];
       std::snprintf(beyond, sizeof beyond, " beyond %g m", certificate.global.rival_distance);
       described += beyond;
+    } else if (certificate.global.tolerance > 0.0) {
+      char within[48];
+      std::snprintf(within, sizeof within, ", tolerance %g m", certificate.global.tolerance);
+      described += within;
     }
   } else {
     described += ", global check off";
@@ -248,6 +268,7 @@ std::string RobustCommandLine(const RobustFlags& flags) {
   if (flags.no_reestimate) line += " --no-reestimate";
   if (flags.global_steps != 4) line += " --global-steps " + std::to_string(flags.global_steps);
   if (!flags.rival_distance.empty()) line += " --rival-distance " + flags.rival_distance;
+  if (!flags.tolerance.empty()) line += " --tolerance " + flags.tolerance;
   if (flags.reestimate_steps != 12) line += " --reestimate-steps " + std::to_string(flags.reestimate_steps);
   if (flags.no_free_space) line += " --no-free-space";
   if (!flags.free_space_fraction.empty()) line += " --free-space-fraction " + flags.free_space_fraction;

@@ -89,7 +89,8 @@ struct RobustFlags {
   std::string free_space_accept;   // --free-space-accept ("" = default, at most the fraction)
   std::string outside_mask;        // --outside-mask-fraction ("" = default)
   std::string uncovered_mask;      // --uncovered-mask-fraction ("" = default)
-  std::string rival_distance;      // --rival-distance ("" = 2 eps_oc)
+  std::string rival_distance;      // --rival-distance ("" = the tolerance - eps_oc)
+  std::string tolerance;           // --tolerance ("" = GlobalUniquenessOptions::Tolerance's default)
 };
 void AddRobustOptions(CLI::App& command, RobustFlags* flags);
 // What the clouds of a run are; where --max-outliers / --robust-loss are not

@@ -21,7 +21,7 @@ for c in "${commands[@]}"; do
   "$C3PO" $c --help > "help.txt" 2>&1 || fail "$c --help exited $?"
   for flag in --eps-oc --delta-nd --loss --max-outliers --robust-loss --nd-min-eigenvalue --no-global-check \
       --global-steps --no-free-space --free-space-fraction --free-space-accept --outside-mask-fraction \
-      --uncovered-mask-fraction --rival-distance --indicator-sets --no-centre; do
+      --uncovered-mask-fraction --rival-distance --tolerance --indicator-sets --no-centre; do
     grep -q -- "$flag" help.txt || fail "$c --help lacks $flag"
   done
   grep -q "allow_extra_args\|->" help.txt && fail "$c --help shows code: $(grep 'allow_extra_args\|->' help.txt)"
@@ -159,15 +159,20 @@ grep -q "centring" c.out && fail "certify without --no-centre mentions centring:
 # counts, and what is certified lies within D + eps_oc of the truth (the
 # loosened bound, docs/method.md). The JSON lines carry D, the summary names it.
 # (-o writes the JSON lines; stdout keeps the summary.)
-"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 4 -o rd0.jsonl > /dev/null 2>&1 || true
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 4 -o rd0.jsonl > rd0.out 2>&1 || true
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 4 --rival-distance 15%d -o rd.jsonl > rd.out 2>&1 || true
 grep -q "global rivals [0-9]* beyond 0.2598" rd.out || fail "certify --rival-distance: summary $(grep -o 'global rivals[^,]*' rd.out)"
 python3 - "$NOSETS" <<'PY' || fail "--rival-distance does not act on the rival search"
-import json, sys
+import json, re, sys
 eps = json.load(open(sys.argv[1]))["eps_oc"]
+d = float(re.search(r"d = ([0-9.e+-]+)\)", open("rd0.out").read()).group(1))
 default = [json.loads(l) for l in open("rd0.jsonl")]
 given = {l["cloud"]: l for l in map(json.loads, open("rd.jsonl"))}
-assert all(abs(l["rival_distance"] - 2 * eps) < 1e-12 for l in default if l["nd_global"] is not None), default
+# The default tolerance max(10 % of d, 3 eps_oc): rho = tolerance - eps_oc, the bound of a certified pose.
+rho = max(0.1 * d, 3 * eps) - eps
+assert all(abs(l["rival_distance"] - rho) < 1e-5 for l in default if l["nd_global"] is not None), (rho, default)
+assert all(abs(l["certified_bound"] - (rho + eps)) < 1e-5 for l in default if l["certified"]), default
+assert all(l["certified_bound"] is None for l in default if not l["certified"]), default
 rivalled = [l for l in default if l["refused_by"] == ["nd_global"]]
 assert rivalled, "no frame refused by nd_global alone: the test lost its case"
 for l in rivalled:
@@ -178,6 +183,25 @@ for l in rivalled:
     if g["certified"]:
         assert g["gt_hausdorff"] <= D + eps, (g["gt_hausdorff"], D, eps)
 PY
+# --tolerance T: the same search as --rival-distance T - eps_oc, every certified
+# pose's certified_bound is T and lies within it of the truth; not with
+# --rival-distance; at or below eps_oc it is refused.
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 4 --tolerance 18%d -o tol.jsonl > tol.out 2>&1 || true
+grep -q "tolerance 0.31" tol.out || fail "certify --tolerance: summary $(grep -o 'global rivals[^;]*' tol.out)"
+python3 - "$NOSETS" <<'PY' || fail "--tolerance is not the rival distance + eps_oc, or a certified pose lies beyond it"
+import json, re, sys
+eps = json.load(open(sys.argv[1]))["eps_oc"]
+d = float(re.search(r"d = ([0-9.e+-]+)\)", open("tol.out").read()).group(1))
+given = {l["cloud"]: l for l in map(json.loads, open("rd.jsonl"))}
+for l in map(json.loads, open("tol.jsonl")):
+    assert abs(l["rival_distance"] - (0.18 * d - eps)) < 1e-5, l["rival_distance"]
+    if l["certified"]:
+        assert abs(l["certified_bound"] - 0.18 * d) < 1e-5
+        assert l["gt_hausdorff"] <= 0.18 * d + 1e-5, (l["gt_hausdorff"], d)
+PY
+bad_value --tolerance "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --tolerance 2cm --rival-distance 2cm
+bad_value --tolerance "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --tolerance 0.1%d
+bad_value --tolerance "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --tolerance 3x
 "$C3PO" eval "$NOSETS" --bop bop --obj-id 3 --detector svd --no-icp > e.out 2>&1 || fail "eval --bop exited $?"
 grep -q "re-estimation on" e.out || fail "eval --bop does not re-estimate by default: $(grep 'outlier budget' e.out)"
 "$C3PO" eval "$NOSETS" --data data --detector svd --no-icp > e.out 2>&1 || fail "eval --data exited $?"

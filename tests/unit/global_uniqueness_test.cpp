@@ -81,6 +81,25 @@ PointSet BoxOnlyCloud(int count, std::uint64_t seed) {
 
 }  // namespace
 
+TEST_CASE("tolerance: rho = tolerance - eps_oc, default max(10 % of d, 3 eps_oc), an explicit rival distance wins") {
+  c3po::GlobalUniquenessOptions options;
+  // Default, 10 % of d dominating (eps_oc = 3 % of d): rho = 7 % of d, above 2 eps_oc.
+  CHECK(options.Tolerance(0.003, 0.1) == doctest::Approx(0.01));
+  CHECK(options.RivalDistance(0.003, 0.1) == doctest::Approx(0.007));
+  // Default, 3 eps_oc dominating (eps_oc = 5 % of d): rho = 2 eps_oc, the truth's own valley never counts.
+  CHECK(options.Tolerance(0.005, 0.1) == doctest::Approx(0.015));
+  CHECK(options.RivalDistance(0.005, 0.1) == doctest::Approx(0.01));
+  options.tolerance = 0.02;   // the user's: 2 cm whatever the diameter
+  CHECK(options.Tolerance(0.005, 1.0) == doctest::Approx(0.02));
+  CHECK(options.RivalDistance(0.005, 1.0) == doctest::Approx(0.015));
+  options.tolerance = 0.004;  // below eps_oc (the CLI refuses it): rho 0, not negative
+  CHECK(options.RivalDistance(0.005, 1.0) == 0.0);
+  options.rival_distance = 0.03;
+  CHECK(options.RivalDistance(0.005, 1.0) == doctest::Approx(0.03));
+  options.tolerance = -1.0;
+  CHECK_THROWS_AS(options.Check(), std::invalid_argument);
+}
+
 TEST_CASE("global uniqueness: hypotheses and axis rotations") {
   GlobalUniquenessOptions options;
   // 3 x 3 turns about the principal axes, then the 10 diagonals' half-turns,

@@ -89,6 +89,11 @@ void AddRobustKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   line["robust_loss"] = ToString(e.correction.robust_loss);
   line["robust_scale"] = e.correction.robust_scale;
   line["outliers"] = oc.outlier_count;
+  // The share of the judged points the pose leaves unexplained (at >= eps_oc).
+  line["unexplained_fraction"] = oc.point_distances.size() > 0
+                                     ? nlohmann::ordered_json(static_cast<double>(oc.outlier_count) /
+                                                              static_cast<double>(oc.point_distances.size()))
+                                     : nlohmann::ordered_json(nullptr);
   const std::size_t listed = std::min(oc.outlier_indices.size(), kMaxListedOutliers);
   line["outlier_indices"] = std::vector<int>(oc.outlier_indices.begin(), oc.outlier_indices.begin() + listed);
   line["outlier_indices_truncated"] = listed < oc.outlier_indices.size();
@@ -120,13 +125,23 @@ void AddWeakMotionKeys(const NonDegeneracy& nd, nlohmann::ordered_json* out) {
 }
 
 // Global rival search (global_uniqueness.hpp); null when not run.
-void AddRivalKeys(const NonDegeneracy& nd, nlohmann::ordered_json* out) {
+void AddRivalKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   nlohmann::ordered_json& line = *out;
+  const NonDegeneracy& nd = e.certificate.nd;
   const GlobalUniqueness& g = nd.global;
   line["nd_global"] = nd.global_checked ? nlohmann::ordered_json(g.passed) : nlohmann::ordered_json(nullptr);
   line["rivals_tried"] = g.rivals_tried;
   line["rivals_found"] = g.rivals_found;
   line["rival_distance"] = g.rival_distance;
+  // What a certificate promises (docs/method.md "Tolerance"): the truth within rival_distance + eps_oc (+ eps_w)
+  // of the pose -- the tolerance; null when not certified or when no rival search ran.
+  line["certified_bound"] = e.certified() && nd.global_checked
+                                ? nlohmann::ordered_json(g.rival_distance + e.certificate.oc.eps_oc)
+                                : nlohmann::ordered_json(nullptr);
+  // How many more points the reported rival leaves unexplained than the pose (null: no rival reported).
+  line["rival_margin"] = g.rival_axis >= 0 && g.rival_outliers >= 0
+                             ? nlohmann::ordered_json(g.rival_outliers - e.certificate.oc.outlier_count)
+                             : nlohmann::ordered_json(nullptr);
   line["rival_hausdorff"] = g.rival_axis >= 0 ? nlohmann::ordered_json(g.rival_hausdorff) : nlohmann::ordered_json(nullptr);
   line["rival_outliers"] = g.rival_outliers;
   line["rival_axis"] = g.rival_axis;
@@ -182,7 +197,7 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   AddPoseAndDecisionKeys(e, out);
   AddRobustKeys(e, out);
   AddWeakMotionKeys(e.certificate.nd, out);
-  AddRivalKeys(e.certificate.nd, out);
+  AddRivalKeys(e, out);
   AddFreeSpaceKeys(e.certificate.free_space, out);
   AddIdentityKeys(e.certificate.identity, out);
   (*out)["ms"] = e.milliseconds;

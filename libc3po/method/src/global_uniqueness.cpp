@@ -21,6 +21,7 @@ void GlobalUniquenessOptions::Check() const {
   if (!(rival_distance >= 0.0 && std::isfinite(rival_distance))) {
     throw std::invalid_argument("global uniqueness rival distance must be >= 0");
   }
+  if (!(tolerance >= 0.0 && std::isfinite(tolerance))) throw std::invalid_argument("tolerance must be >= 0");
   if (!(rival_extra_fraction >= 0.0 && rival_extra_fraction < 1.0)) {
     throw std::invalid_argument("global uniqueness rival slack must be in [0, 1)");
   }
@@ -28,6 +29,16 @@ void GlobalUniquenessOptions::Check() const {
   if (reestimate_steps < 2 || reestimate_steps > 36 || reestimate_steps % 2 != 0) {
     throw std::invalid_argument("re-estimation steps must be even and in [2, 36]");
   }
+}
+
+double GlobalUniquenessOptions::Tolerance(double eps_oc, double diameter) const {
+  if (tolerance > 0.0) return tolerance;
+  return std::max(kDefaultToleranceFraction * diameter, 3.0 * eps_oc);
+}
+
+double GlobalUniquenessOptions::RivalDistance(double eps_oc, double diameter) const {
+  if (rival_distance > 0.0) return rival_distance;
+  return std::max(Tolerance(eps_oc, diameter) - eps_oc, 0.0);
 }
 
 int GlobalUniquenessOptions::RivalSlack(Eigen::Index n) const {
@@ -207,7 +218,7 @@ WeakMotionCheck CheckWeakMotion(const ObjectModel& object, const PointSet& cloud
   WeakMotionCheck check;
   if (!estimate.ok()) return check;
   const GlobalUniquenessOptions& global = pipeline.certificate.global;
-  const double rival_distance = global.rival_distance > 0.0 ? global.rival_distance : 2.0 * pipeline.certificate.eps_oc;
+  const double rival_distance = global.RivalDistance(pipeline.certificate.eps_oc, object.diameter());
   const Eigen::Matrix<double, 6, 1> motion = estimate.certificate.nd.local.motion;
   std::vector<RivalStart> starts;
   for (double step = 1.5 * rival_distance; step <= object.diameter() && step > 0; step *= 2.0) {
@@ -242,7 +253,7 @@ GlobalUniqueness CheckGlobalUniqueness(const ObjectModel& object, const PointSet
                                        const PipelineOptions& pipeline, const RivalFilter* filter) {
   const GlobalUniquenessOptions& options = pipeline.certificate.global;
   GlobalUniqueness global;
-  global.rival_distance = options.rival_distance > 0.0 ? options.rival_distance : 2.0 * pipeline.certificate.eps_oc;
+  global.rival_distance = options.RivalDistance(pipeline.certificate.eps_oc, object.diameter());
   if (!estimate.ok()) {
     global.passed = false;
     return global;

@@ -136,7 +136,7 @@ void Centre(const ObjectModel& object, const PointSet& judged, const PipelineOpt
   if (fits.empty()) return;
   const double eps_oc = options.certificate.eps_oc;
   const GlobalUniquenessOptions& global = options.certificate.global;
-  const double rho = global.rival_distance > 0.0 ? global.rival_distance : 2.0 * eps_oc;
+  const double rho = global.RivalDistance(eps_oc, object.diameter());
   const PointSet queries = StridedColumns(object.sample(), 1000);
   for (const Pose& rival : fits) {
     if (!(PosedModelHausdorff(object, queries, estimate->scene_from_model, rival) <= 2.0 * rho)) return;

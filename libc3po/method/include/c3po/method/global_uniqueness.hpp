@@ -57,12 +57,27 @@ struct GlobalUniquenessOptions {
   // (even: the half-turns are included). 4: 90°, 180°, 270° (9 rivals; with
   // the 10 diagonal half-turns and T̂'s own refit, 20).
   int steps = 4;
-  // A rival counts when Hausdorff(T̂·B̂, T'·B̂) > rival_distance; 0 = 2·eps_oc.
-  // Two poses that both satisfy the guarantee lie within eps_oc + eps_w of
-  // the truth, hence within 2(eps_oc + eps_w) of each other: a rival beyond
-  // that proves one of them wrong. eps_w is unknown; 2·eps_oc <= 2(eps_oc +
-  // eps_w) refuses at least every such rival (docs/method.md).
+  // The accuracy the user needs (object units): a certified pose lies within
+  // `tolerance` (+ the sensor noise eps_w) of the truth, as far as the search
+  // reaches (docs/method.md "Tolerance"). A second fit that explains the
+  // evidence counts as a rival when it lies farther than rho = tolerance -
+  // eps_oc from the estimate (Hausdorff between the posed models): the truth,
+  // if it is such a fit, is then within rho of the estimate and the estimate
+  // within rho + eps_oc = tolerance of it. 0 = the default,
+  // DefaultTolerance(): 10 % of the object's diameter -- the accuracy pose
+  // benchmarks call correct (ADD(-S) < 0.1 d since Hinterstoisser et al. 2012;
+  // BOP's MSSD counts 5-50 % of d), here as a Hausdorff distance, which is
+  // stricter -- and at least 3 eps_oc: two fits within 2 eps_oc of each other
+  // may both be the truth's (each within eps_oc + eps_w of it), so rho below
+  // 2 eps_oc would refuse the truth's own valley.
+  double tolerance = 0.0;
+  // Expert: rho itself (> 0 overrides the tolerance; the bound is then
+  // rival_distance + eps_oc).
   double rival_distance = 0.0;
+  // 3 eps_oc <= tolerance, or the default.
+  double Tolerance(double eps_oc, double diameter) const;
+  // rho (see above).
+  double RivalDistance(double eps_oc, double diameter) const;
   // Rivals are judged with a looser oc than the estimate: at most m +
   // max(floor(rival_extra_fraction·n), rival_extra_min) points beyond eps_oc
   // (n = cloud size). The estimate must beat every far pose by more than a
@@ -75,8 +90,11 @@ struct GlobalUniquenessOptions {
   int rival_extra_min = 10;
   // The slack in points for a cloud of n points.
   int RivalSlack(Eigen::Index n) const;
-  void Check() const;   // steps, reestimate_steps even and in [2, 36], rival_distance >= 0 finite, fraction in [0, 1), min >= 0
+  void Check() const;   // steps, reestimate_steps even and in [2, 36], tolerance and rival_distance >= 0 finite, fraction in [0, 1), min >= 0
 };
+
+// The default tolerance's fraction of the diameter (see `tolerance`).
+inline constexpr double kDefaultToleranceFraction = 0.1;
 
 // The evidence (part of NonDegeneracy, certificate.hpp).
 struct GlobalUniqueness {
