@@ -365,16 +365,6 @@ void SetMaskErosion(const std::string& text, SegmentOptions* options) {
   options->erode_mask_metres = width;
 }
 
-std::string DescribeMaskErosion(const SegmentOptions& options) {
-  char text[64];
-  if (options.erode_mask_metres > 0.0) {
-    std::snprintf(text, sizeof text, "%g mm", options.erode_mask_metres * 1000.0);
-  } else {
-    std::snprintf(text, sizeof text, "%d px", options.erode_mask);
-  }
-  return text;
-}
-
 void AddSegmentOptions(CLI::App& command, SegmentOptions* options) {
   command
       .add_option_function<std::string>(

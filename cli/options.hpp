@@ -147,8 +147,6 @@ void AddSegmentOptions(CLI::App& command, SegmentOptions* options);
 // --erode-mask's value: "3mm" / "0.5cm" / "0.003m" (a width at the segment's
 // depth) or "4" / "4px" (pixels); CLI::ValidationError otherwise.
 void SetMaskErosion(const std::string& text, SegmentOptions* options);
-// "3 mm" or "4 px".
-std::string DescribeMaskErosion(const SegmentOptions& options);
 // options->Check() as an InputError naming the command.
 void CheckSegmentOptions(const SegmentOptions& options, const std::string& command);
 // --evidence-erode-mask: "auto" (default) or K pixels. Resolved into
