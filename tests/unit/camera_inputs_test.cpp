@@ -484,6 +484,37 @@ TEST_CASE("unusable segments: no pixels, no depth, too few points left") {
                                 "0 on depth edges, 0 on the support plane)");
 }
 
+TEST_CASE("the erosion floor (one distance transform) equals lowering k through brute-force erosions") {
+  std::mt19937 rng(5);
+  const int w = 48, h = 36;
+  for (int trial = 0; trial < 60; ++trial) {
+    CAPTURE(trial);
+    // A random blob: the union of a few rectangles (some touching the border), depth missing at random.
+    Mask mask{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h, 0)};
+    for (int r = 0; r < 3; ++r) {
+      const int u0 = static_cast<int>(rng() % w), v0 = static_cast<int>(rng() % h);
+      const int u1 = std::min(w, u0 + 1 + static_cast<int>(rng() % 20)), v1 = std::min(h, v0 + 1 + static_cast<int>(rng() % 15));
+      for (int v = v0; v < v1; ++v) for (int u = u0; u < u1; ++u) mask.inside[static_cast<std::size_t>(v) * w + u] = 1;
+    }
+    DepthImage depth{w, h, std::vector<float>(static_cast<std::size_t>(w) * h, 1.0f)};
+    for (float& z : depth.z) if (rng() % 5 == 0) z = 0.0f;
+    const auto with_depth = [&](const Mask& m) {
+      std::size_t count = 0;
+      for (std::size_t i = 0; i < m.inside.size(); ++i) count += m.inside[i] != 0 && depth.z[i] > 0.0f;
+      return count;
+    };
+    for (int asked : {0, 1, 2, 4, 7}) {
+      c3po::SegmentOptions options;
+      options.erode_mask_metres = 0.0;
+      options.erode_mask = asked;
+      const double keep = options.min_eroded_fraction * static_cast<double>(with_depth(mask));
+      int expected = with_depth(mask) == 0 ? 0 : asked;
+      while (expected > 0 && static_cast<double>(with_depth(c3po::ErodeMask(mask, expected))) < keep) --expected;
+      CHECK(c3po::ErosionPixels(depth, mask, kCamera, options) == expected);
+    }
+  }
+}
+
 TEST_CASE("metric erosion: k = round(f w / median depth), the same band in metres at any distance and focal length") {
   // A flat 120 x 90 px mask at depth z; a 3 mm band is round(f * 0.003 / z) px (at most 11 here, which keeps
   // 98 x 68 px, more than half: the floor does not act).

@@ -56,6 +56,15 @@ Mesh CylinderMesh(double radius, double height, int segments) {
   return mesh;
 }
 
+ObjectSpec Spec(const std::string& name, const Eigen::Matrix3d& keypoints, double eps_oc, double delta_nd) {
+  ObjectSpec spec;
+  spec.name = name;
+  spec.keypoints = keypoints;
+  spec.eps_oc = eps_oc;
+  spec.delta_nd = delta_nd;
+  return spec;
+}
+
 CertificateOptions WithBudget(const ObjectModel& object, OutlierBudget budget) {
   CertificateOptions options = CertificateOptions::FromObject(object.spec());
   options.max_outliers = budget;
@@ -348,11 +357,7 @@ TEST_CASE("refusal: every failed part is named with its evidence, nothing when c
 
 TEST_CASE("local non-degeneracy: a box seen face-on fails, a corner view passes") {
   const Eigen::Vector3d size(0.2, 0.1, 0.3);
-  ObjectSpec spec;
-  spec.name = "box";
-  spec.keypoints = 0.5 * Eigen::Matrix3d(size.asDiagonal());
-  spec.eps_oc = 0.01;
-  spec.delta_nd = 0.01;
+  const ObjectSpec spec = Spec("box", 0.5 * Eigen::Matrix3d(size.asDiagonal()), 0.01, 0.01);
   ObjectModelOptions model_options;
   model_options.sample_size = 20000;
   const ObjectModel box(spec, test::BoxMesh({0, 0, 0}, size), model_options);
@@ -376,11 +381,7 @@ TEST_CASE("local non-degeneracy: a box seen face-on fails, a corner view passes"
 }
 
 TEST_CASE("local non-degeneracy: a body of revolution's spin is a harmless symmetry") {
-  ObjectSpec spec;
-  spec.name = "cylinder";
-  spec.keypoints = Eigen::Matrix3d::Identity() * 0.03;
-  spec.eps_oc = 0.005;
-  spec.delta_nd = 0.005;
+  const ObjectSpec spec = Spec("cylinder", Eigen::Matrix3d::Identity() * 0.03, 0.005, 0.005);
   ObjectModelOptions model_options;
   model_options.sample_size = 20000;
   const ObjectModel cylinder(spec, CylinderMesh(0.04, 0.12, 512), model_options);
@@ -426,11 +427,7 @@ Mesh BowlMesh() {
 }  // namespace
 
 TEST_CASE("local non-degeneracy: a thin-walled bowl -- its two faces are no crease, its spin is harmless") {
-  ObjectSpec spec;
-  spec.name = "bowl";
-  spec.keypoints = Eigen::Matrix3d::Identity() * 0.05;
-  spec.eps_oc = 0.007;
-  spec.delta_nd = 0.0035;
+  const ObjectSpec spec = Spec("bowl", Eigen::Matrix3d::Identity() * 0.05, 0.007, 0.0035);
   const ObjectModel bowl(spec, BowlMesh(), ObjectModelOptions{});
   // Brute force over 500 samples: how many have, among their 8 nearest, a normal facing the other way (the
   // other face of the wall)? Those a "> 30 degrees off" crease rule would all drop.

@@ -121,19 +121,24 @@ bool OnDepthDiscontinuity(const DepthImage& depth, int u, int v, double step) {
   return false;
 }
 
-// Mask pixels with a valid depth.
-std::size_t WithDepth(const DepthImage& depth, const Mask& mask) {
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < mask.inside.size(); ++i) count += mask.inside[i] != 0 && DepthImage::Valid(depth.z[i]);
-  return count;
-}
-
 }  // namespace
 
 int ErosionPixels(const DepthImage& depth, const Mask& mask, const PinholeCamera& camera, const SegmentOptions& options) {
+  // A pixel survives erosion by k iff its chessboard distance to the nearest
+  // in-image pixel outside the mask exceeds k: one distance transform of the
+  // complement gives, for every k at once, how many pixels with depth remain.
+  if (depth.width != mask.width || depth.height != mask.height) throw std::invalid_argument("ErosionPixels: sizes differ");
+  Mask outside = mask;
+  for (std::uint8_t& m : outside.inside) m = m == 0;
+  const std::vector<int> depth_in = MaskDistance(outside);
   std::vector<float> z;
+  std::vector<std::size_t> at_distance;   // pixels with depth by distance to the outside
   for (std::size_t i = 0; i < mask.inside.size(); ++i) {
-    if (mask.inside[i] != 0 && DepthImage::Valid(depth.z[i])) z.push_back(depth.z[i]);
+    if (mask.inside[i] == 0 || !DepthImage::Valid(depth.z[i])) continue;
+    z.push_back(depth.z[i]);
+    const std::size_t d = static_cast<std::size_t>(std::min(depth_in[i], 1001));
+    if (at_distance.size() <= d) at_distance.resize(d + 1, 0);
+    ++at_distance[d];
   }
   if (z.empty()) return 0;
   int k = options.erode_mask;
@@ -143,8 +148,16 @@ int ErosionPixels(const DepthImage& depth, const Mask& mask, const PinholeCamera
     const double f = 0.5 * (camera.fx + camera.fy);
     k = static_cast<int>(std::min(1000.0, std::round(f * options.erode_mask_metres / static_cast<double>(*middle))));
   }
+  if (options.min_eroded_fraction <= 0.0) return k;
+  // kept(k) = pixels with depth at distance > k; lower k until it keeps the fraction.
   const double keep = options.min_eroded_fraction * static_cast<double>(z.size());
-  while (k > 0 && options.min_eroded_fraction > 0.0 && static_cast<double>(WithDepth(depth, ErodeMask(mask, k))) < keep) --k;
+  std::vector<std::size_t> beyond(at_distance.size() + 1, 0);
+  for (std::size_t d = at_distance.size(); d-- > 0;) beyond[d] = beyond[d + 1] + at_distance[d];
+  const auto kept = [&](int radius) {
+    const std::size_t first = static_cast<std::size_t>(radius) + 1;
+    return first < beyond.size() ? beyond[first] : std::size_t{0};
+  };
+  while (k > 0 && static_cast<double>(kept(k)) < keep) --k;
   return k;
 }
 

@@ -63,8 +63,8 @@ struct GlobalUniquenessOptions {
   // evidence counts as a rival when it lies farther than rho = tolerance -
   // eps_oc from the estimate (Hausdorff between the posed models): the truth,
   // if it is such a fit, is then within rho of the estimate and the estimate
-  // within rho + eps_oc = tolerance of it. 0 = the default,
-  // DefaultTolerance(): 10 % of the object's diameter -- the accuracy pose
+  // within rho + eps_oc = tolerance of it. 0 = the default (Tolerance()):
+  // 10 % of the object's diameter -- the accuracy pose
   // benchmarks call correct (ADD(-S) < 0.1 d since Hinterstoisser et al. 2012;
   // BOP's MSSD counts 5-50 % of d), here as a Hausdorff distance, which is
   // stricter -- and at least 3 eps_oc: two fits within 2 eps_oc of each other
@@ -74,7 +74,7 @@ struct GlobalUniquenessOptions {
   // Expert: rho itself (> 0 overrides the tolerance; the bound is then
   // rival_distance + eps_oc).
   double rival_distance = 0.0;
-  // 3 eps_oc <= tolerance, or the default.
+  // `tolerance` when given, else max(kDefaultToleranceFraction·diameter, 3·eps_oc).
   double Tolerance(double eps_oc, double diameter) const;
   // rho (see above).
   double RivalDistance(double eps_oc, double diameter) const;
