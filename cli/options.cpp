@@ -371,7 +371,7 @@ void AddSegmentOptions(CLI::App& command, SegmentOptions* options) {
           "--erode-mask", [options](const std::string& text) { SetMaskErosion(text, options); },
           "Erode masks for the estimate (the detector and the corrector) by a width at the segment's depth (3mm, "
           "0.5cm: the same band on every camera) or by K pixels (4, 4px); 0 = off. Lowered where it would leave "
-          "less than half of the segment (default 3mm)")
+          "less than half of the segment (default 4)")
       ->type_name("W");
   command.add_option("--depth-edge", options->max_relative_depth_step,
                      "Drop pixels whose depth differs from a neighbour's by more than this fraction of their "

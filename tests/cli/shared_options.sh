@@ -269,21 +269,22 @@ for l in open('c.jsonl'):
 }
 mask_option --outside-mask-fraction outside_mask_limit 0.05 mask seen_outside_mask free_space_measured
 mask_option --uncovered-mask-fraction uncovered_mask_limit 0.035 uncovered mask_uncovered mask_at_depth
-# --erode-mask: a width at the segment's depth (default 3mm) or pixels. Every
+# --erode-mask: a width at the segment's depth or pixels (default 4). Every
 # frame's k (erode_pixels) is round(f * w / median depth) lowered by the
 # half-segment floor, so it never exceeds the width's pixels; pixels are taken
 # as given (or lowered by the floor); 0 = off; malformed widths are one-line errors.
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd -o e_default.jsonl > /dev/null 2>&1 || true
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 3mm -o e_3mm.jsonl > /dev/null 2>&1 || true
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 6px -o e_6px.jsonl > /dev/null 2>&1 || true
+"$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 4px -o e_4px.jsonl > /dev/null 2>&1 || true
 "$C3PO" certify "$NOSETS" --bop bop --obj-id 3 --detector svd --erode-mask 0 -o e_0.jsonl > /dev/null 2>&1 || true
 python3 - "$SRC" <<'PY' || fail "--erode-mask: erode_pixels not as the width, pixels or 0 give"
 import json
 rows = lambda f: [json.loads(l) for l in open(f)]
 default, mm3, px6, off = rows('e_default.jsonl'), rows('e_3mm.jsonl'), rows('e_6px.jsonl'), rows('e_0.jsonl')
-cams = json.load(open('bop/000000/scene_camera.json'))
-assert len(default) == 2 and [r['erode_pixels'] for r in default] == [r['erode_pixels'] for r in mm3]
-for r in default:
+px4 = rows('e_4px.jsonl')
+assert len(default) == 2 and [r['erode_pixels'] for r in default] == [r['erode_pixels'] for r in px4]
+for r in mm3:
     assert 0 <= r['erode_pixels'] <= 1000
 for r in px6:
     assert 0 < r['erode_pixels'] <= 6

@@ -468,7 +468,7 @@ TEST_CASE("unusable segments: no pixels, no depth, too few points left") {
   depth.z.assign(36, 1.0f);
   Mask dot = empty;
   dot.inside[14] = 1;
-  // A one-pixel segment: the default erosion (3 mm = 2 px at 1 m) would remove all of it, so the floor
+  // A one-pixel segment: the default erosion (4 px) would remove all of it, so the floor
   // (min_eroded_fraction) keeps it uneroded; without the floor it is eroded away. (The flat frame would be one
   // support plane taking the dot: that step is off here.)
   c3po::SegmentOptions floor;
@@ -528,6 +528,7 @@ TEST_CASE("metric erosion: k = round(f w / median depth), the same band in metre
       const DepthImage depth{w, h, std::vector<float>(static_cast<std::size_t>(w) * h, static_cast<float>(z))};
       const c3po::PinholeCamera camera{f, f, 80.0, 60.0};
       c3po::SegmentOptions options;   // 3 mm, floor 0.5
+      options.erode_mask_metres = 0.003;
       options.max_points = 0;
       options.support_plane_distance = 0.0;
       const int expected = static_cast<int>(std::round(f * 0.003 / z));
@@ -545,6 +546,7 @@ TEST_CASE("metric erosion: k = round(f w / median depth), the same band in metre
   for (int v = 20; v < 26; ++v) for (int u = 5; u < 75; ++u) strip.inside[static_cast<std::size_t>(v) * w + u] = 1;
   const DepthImage near{w, h, std::vector<float>(static_cast<std::size_t>(w) * h, 0.3f)};
   c3po::SegmentOptions options;
+  options.erode_mask_metres = 0.003;
   CHECK(c3po::ErosionPixels(near, strip, c3po::PinholeCamera{1067.0, 1067.0, 40.0, 30.0}, options) == 1);
   options.erode_mask_metres = 0.0;
   options.erode_mask = 5;
@@ -555,6 +557,7 @@ TEST_CASE("metric erosion: k = round(f w / median depth), the same band in metre
   DepthImage mixed = near;
   for (int u = 30; u < 40; ++u) mixed.z[static_cast<std::size_t>(50) * w + u] = 5.0f;
   options = c3po::SegmentOptions{};
+  options.erode_mask_metres = 0.003;
   CHECK(c3po::ErosionPixels(mixed, mask, c3po::PinholeCamera{1067.0, 1067.0, 40.0, 30.0}, options) ==
         static_cast<int>(std::round(1067.0 * 0.003 / 0.3)));
 }
