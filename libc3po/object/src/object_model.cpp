@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
+#include <mutex>
 #include <limits>
 #include <set>
 #include <stdexcept>
@@ -52,6 +53,16 @@ void ObjectModelOptions::Check() const {
   if (sample_size < 100) throw std::invalid_argument("ObjectModelOptions: sample_size must be >= 100");
 }
 
+struct ObjectModel::LazyGrid {
+  std::once_flag built;
+  std::unique_ptr<const NearestGrid> grid;
+};
+
+const NearestGrid& ObjectModel::grid() const {
+  std::call_once(grid_->built, [this] { grid_->grid = std::make_unique<const NearestGrid>(tree_); });
+  return *grid_->grid;
+}
+
 ObjectModel::ObjectModel(ObjectSpec spec, Mesh mesh, const ObjectModelOptions& options)
     : spec_(std::move(spec)), mesh_(std::move(mesh)) {
   options.Check();
@@ -70,6 +81,7 @@ ObjectModel::ObjectModel(ObjectSpec spec, Mesh mesh, const ObjectModelOptions& o
   for (Eigen::Index i = 0; i < sample.points.cols(); ++i) (*triangles)[static_cast<std::size_t>(i)] = sample.triangle(i);
   triangles_ = std::move(triangles);
   tree_ = std::make_shared<const PointTree>(std::move(sample.points));
+  grid_ = std::make_shared<LazyGrid>();
   diameter_ = mesh_.Diameter();
   // Crease flags: a sample point whose 8 nearest sample neighbours include a
   // normal more than 30 degrees off its own line lies at an edge or crease,
@@ -125,7 +137,7 @@ std::string ObjectModel::KeypointHash() const {
 void ObjectModel::NearestInPosedModel(const PointSet& scene, const Pose& scene_from_model, Eigen::VectorXi* indices,
                                       Eigen::VectorXd* squared_distances, const Eigen::VectorXi* hints) const {
   // ||x - (R p + t)|| = ||R^T (x - t) - p||: query the model-frame tree.
-  tree_->NearestBatch(scene_from_model.InverseApply(scene), indices, squared_distances, hints);
+  grid().NearestBatch(scene_from_model.InverseApply(scene), indices, squared_distances, hints);
 }
 
 Eigen::VectorXd ObjectModel::DistancesToPosedModel(const PointSet& scene,

@@ -10,6 +10,7 @@
 #include "c3po/base/types.hpp"
 #include "c3po/geometry/kdtree.hpp"
 #include "c3po/geometry/mesh.hpp"
+#include "c3po/geometry/nearest_grid.hpp"
 
 namespace c3po {
 
@@ -52,6 +53,9 @@ class ObjectModel {
   int num_keypoints() const { return spec_.num_keypoints(); }
   const PointSet& sample() const { return tree_->points(); }   // B̂, model frame
   const PointTree& tree() const { return *tree_; }
+  // The exact nearest-neighbour grid over B̂ that NearestInPosedModel queries,
+  // built at its first use (thread-safe; copies of the model share it).
+  const NearestGrid& grid() const;
   // Unit outward normals of B̂ (of the triangle each sample point lies on).
   const PointSet& sample_normals() const { return *normals_; }
   // Mesh triangle each sample point lies on.
@@ -69,9 +73,10 @@ class ObjectModel {
   std::string KeypointHash() const;
 
   // Nearest model-sample point of every scene point under pose T, computed as
-  // queries of R^T (x - t) against the model-frame tree (no per-pose rebuild).
-  // `hints` (one sample index per scene point, e.g. its nearest at the
-  // previous iterate) give the same result faster (PointTree::Nearest).
+  // queries of R^T (x - t) against the model-frame grid (no per-pose rebuild;
+  // exact, nearest_grid.hpp). `hints` (one sample index per scene point, e.g.
+  // its nearest at the previous iterate) speed up the queries the grid hands
+  // to the tree.
   void NearestInPosedModel(const PointSet& scene, const Pose& scene_from_model, Eigen::VectorXi* indices,
                            Eigen::VectorXd* squared_distances, const Eigen::VectorXi* hints = nullptr) const;
   // Distances (not squared) of every scene point to the posed model sample.
@@ -81,6 +86,8 @@ class ObjectModel {
   ObjectSpec spec_;
   Mesh mesh_;
   std::shared_ptr<const PointTree> tree_;
+  struct LazyGrid;
+  std::shared_ptr<LazyGrid> grid_;
   std::shared_ptr<const PointSet> normals_;
   std::shared_ptr<const std::vector<int>> triangles_;
   std::shared_ptr<const std::vector<char>> crease_;
