@@ -1,5 +1,6 @@
 // c3po bench: speed and accuracy figures of components, printed as tables
 // (and JSON with --json FILE). Benchmarks are commands, never timed tests.
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -125,6 +126,20 @@ void PrintCorrectorBenchHeader(const ObjectModel& object, const CorrectorBenchma
               "%corr", "%cert", "%c.cert", "false", "nd q05");
 }
 
+// Where each row's time goes: mean ms per cloud of each stage and its share.
+void PrintStageShares(const std::vector<CorrectorBenchmarkRow>& rows) {
+  std::printf("stages, mean ms per cloud (share of the row's time):\n");
+  for (const auto& row : rows) {
+    const StageTimes& t = row.mean_stages;
+    const double total = std::max(t.Total(), 1e-300);
+    auto share = [total](double ms) { return 100.0 * ms / total; };
+    std::printf("%6.2f  %-18s corrector %.3f (%.0f%%), certificate %.3f (%.0f%%), weak motion %.3f (%.0f%%), "
+                "rival search %.3f (%.0f%%)\n",
+                row.sigma, row.method.c_str(), t.corrector, share(t.corrector), t.certificate, share(t.certificate),
+                t.weak_motion, share(t.weak_motion), t.rival_search, share(t.rival_search));
+  }
+}
+
 // Prints each row under the header and returns them as the --json document.
 nlohmann::json PrintCorrectorBenchRows(const std::vector<CorrectorBenchmarkRow>& rows) {
   nlohmann::json json = nlohmann::json::array();
@@ -151,8 +166,14 @@ nlohmann::json PrintCorrectorBenchRows(const std::vector<CorrectorBenchmarkRow>&
                     {"max_certified_hausdorff", row.max_certified_hausdorff},
                     {"median_hausdorff", row.median_hausdorff},
                     {"q05_nd_eigenvalue_correct", row.q05_nd_eigenvalue_correct},
-                    {"percent_nd_local", row.percent_nd_local}});
+                    {"percent_nd_local", row.percent_nd_local},
+                    {"mean_ms_stages", {{"corrector", row.mean_stages.corrector},
+                                        {"certificate", row.mean_stages.certificate},
+                                        {"free_space", row.mean_stages.free_space},
+                                        {"weak_motion", row.mean_stages.weak_motion},
+                                        {"rival_search", row.mean_stages.rival_search}}}});
   }
+  PrintStageShares(rows);
   return json;
 }
 

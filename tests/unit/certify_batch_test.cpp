@@ -118,6 +118,18 @@ TEST_CASE("CertifyBatch with given keypoints equals EstimateAndCertify cloud by 
       CHECK_FALSE(outcome.uncorrected.has_value());
       const PoseEstimate direct = EstimateAndCertify(f.object, f.clouds[i], f.detected[i], options.pipeline);
       CheckSameEstimate(outcome.estimate, direct);
+      // The stages are disjoint parts of the measured times: the estimate's
+      // within `ms`, all of them within the outcome's seconds.
+      const StageTimes& t = outcome.estimate.ms_stages;
+      for (double stage : {t.load, t.detect, t.corrector, t.certificate, t.free_space, t.weak_motion, t.rival_search,
+                           t.reestimation, t.centring, t.identity}) {
+        CHECK(stage >= 0.0);
+      }
+      CHECK(t.Total() - t.load - t.detect <= outcome.estimate.milliseconds + 1e-9);
+      CHECK(t.Total() <= 1000.0 * outcome.seconds + 1e-9);
+      if (outcome.estimate.restart_axis < 0 && !outcome.estimate.centred) {   // else the replacement's search
+        CHECK((t.rival_search > 0.0) == outcome.estimate.certificate.nd.global_checked);
+      }
       certified += direct.certified();
       oc += direct.certificate.oc.passed;
       nd += direct.certificate.nd.passed;
@@ -359,7 +371,8 @@ TEST_CASE("certify JSON lines: every field of the schema, in order, read back") 
                                          "free_space_shift_px", "through_support", "seen_surface",
                                          "seen_outside_mask", "outside_mask_limit", "mask_at_depth", "mask_uncovered",
                                          "uncovered_mask_limit", "identity", "identity_objects", "identity_rival",
-                                         "identity_rival_oc_distance", "identity_rival_R", "identity_rival_t", "ms"});
+                                         "identity_rival_oc_distance", "identity_rival_R", "identity_rival_t", "ms",
+                                         "ms_stages"});
   CHECK(j["cloud"] == "a.ply");
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) CHECK(j["R"][r][c].get<double>() == e.scene_from_model.R(r, c));

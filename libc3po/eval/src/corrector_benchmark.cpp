@@ -78,6 +78,7 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
     pose = registration.scene_from_model;
   }
   out.corrector_ms = MillisecondsSince(start);
+  out.stages.corrector = out.corrector_ms;
   out.corrector_cpu_ms = ThreadCpuMilliseconds() - cpu_start;
   const auto certify_start = std::chrono::steady_clock::now();
   PoseEstimate estimate;   // the whole certificate, with the global rival search (pipeline.hpp)
@@ -85,11 +86,15 @@ Sample RunOne(const ObjectModel& object, const PointSet& cloud, const PointSet& 
     estimate.scene_from_model = pose;
     estimate.keypoints = keypoints;
     estimate.certificate = Certify(object, cloud, pose, keypoints, options.certificate);
+    out.stages.certificate = MillisecondsSince(certify_start);
     PipelineOptions pipeline;
     pipeline.corrector = options.corrector;
     if (solver) pipeline.corrector.solver = *solver;
     pipeline.certificate = options.certificate;
     CompleteCertificate(object, cloud, pipeline, nullptr, &estimate);
+    out.stages.free_space = estimate.ms_stages.free_space;
+    out.stages.weak_motion = estimate.ms_stages.weak_motion;
+    out.stages.rival_search = estimate.ms_stages.rival_search;
   }
   const Certificate& certificate = estimate.certificate;
   out.oc = ok && certificate.oc.passed;
@@ -124,6 +129,11 @@ void SummariseAccuracyAndSpeed(const std::vector<Sample>& samples, CorrectorBenc
     corrector_ms.push_back(s.corrector_ms);
     corrector_cpu_ms.push_back(s.corrector_cpu_ms);
     certify_ms.push_back(s.certify_ms);
+    row->mean_stages.corrector += s.stages.corrector;
+    row->mean_stages.certificate += s.stages.certificate;
+    row->mean_stages.free_space += s.stages.free_space;
+    row->mean_stages.weak_motion += s.stages.weak_motion;
+    row->mean_stages.rival_search += s.stages.rival_search;
     oc += s.oc;
     iterations += s.iterations;
   }
@@ -133,6 +143,13 @@ void SummariseAccuracyAndSpeed(const std::vector<Sample>& samples, CorrectorBenc
   row->mean_translation_over_d = Mean(trans);
   row->median_adds_over_d = Median(adds);
   row->percent_oc = samples.empty() ? 0.0 : 100.0 * oc / static_cast<double>(samples.size());
+  if (!samples.empty()) {
+    const double n = static_cast<double>(samples.size());
+    for (double* stage : {&row->mean_stages.corrector, &row->mean_stages.certificate, &row->mean_stages.free_space,
+                          &row->mean_stages.weak_motion, &row->mean_stages.rival_search}) {
+      *stage /= n;
+    }
+  }
   row->median_ms = Median(ms);
   row->mean_ms = Mean(ms);
   row->median_corrector_ms = Median(corrector_ms);

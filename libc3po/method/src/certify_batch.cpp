@@ -166,6 +166,10 @@ void CertifyBatchOptions::Check() const {
 
 namespace {
 
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
 void RequireDetectorOrKeypoints(const std::vector<CloudSource>& sources, const Detector* detector) {
   if (detector) return;
   for (const CloudSource& source : sources) {
@@ -236,9 +240,12 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
     RecordFailure(&outcome, CloudOutcome::Failure::kLoad,
                   [&] { cloud = LoadSourceCloud(source, &outcome.segment, &view, &evidence); });
     if (!outcome.processed()) return;
+    const double load_ms = MillisecondsSince(start);
+    const auto detect_start = std::chrono::steady_clock::now();
     RecordFailure(&outcome, CloudOutcome::Failure::kDetect,
                   [&] { DetectKeypoints(source, cloud, detector, object.num_keypoints(), &outcome); });
     if (!outcome.processed()) return;
+    const double detect_ms = MillisecondsSince(detect_start);
     const std::optional<FreeSpaceTest> free_space = MakeFreeSpaceTest(
         object, view, options.pipeline.certificate.free_space, options.pipeline.certificate.eps_oc);
     const FreeSpaceTest* free_space_test = free_space ? &*free_space : nullptr;
@@ -252,9 +259,11 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
     if (!options.other_objects.empty() && outcome.estimate.certified()) {   // part of the certificate's time
       const auto identity_start = std::chrono::steady_clock::now();
       outcome.estimate.certificate.identity = CheckIdentity(options.other_objects, cloud, view, judged);
-      outcome.estimate.milliseconds +=
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - identity_start).count();
+      outcome.estimate.ms_stages.identity = MillisecondsSince(identity_start);
+      outcome.estimate.milliseconds += outcome.estimate.ms_stages.identity;
     }
+    outcome.estimate.ms_stages.load = load_ms;
+    outcome.estimate.ms_stages.detect = detect_ms;
     if (source.scene_from_model_truth && outcome.estimate.ok()) {
       outcome.truth_hausdorff = PosedModelHausdorff(object, StridedColumns(object.sample(), 2000),
                                                     *source.scene_from_model_truth, outcome.estimate.scene_from_model);

@@ -201,6 +201,17 @@ void AddEstimateKeys(const PoseEstimate& e, nlohmann::ordered_json* out) {
   AddFreeSpaceKeys(e.certificate.free_space, out);
   AddIdentityKeys(e.certificate.identity, out);
   (*out)["ms"] = e.milliseconds;
+  const StageTimes& t = e.ms_stages;
+  (*out)["ms_stages"] = {{"load", t.load},
+                         {"detect", t.detect},
+                         {"corrector", t.corrector},
+                         {"certificate", t.certificate},
+                         {"free_space", t.free_space},
+                         {"weak_motion", t.weak_motion},
+                         {"rival_search", t.rival_search},
+                         {"reestimation", t.reestimation},
+                         {"centring", t.centring},
+                         {"identity", t.identity}};
 }
 
 }  // namespace

@@ -11,6 +11,19 @@
 
 namespace c3po {
 
+double StageTimes::Total() const {
+  return load + detect + corrector + certificate + free_space + weak_motion + rival_search + reestimation + centring +
+         identity;
+}
+
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
 void PipelineOptions::Check() const {
   if (max_corrector_points < 0) throw std::invalid_argument("max_corrector_points must be >= 0");
   corrector.Check();
@@ -37,16 +50,25 @@ void CompleteCertificate(const ObjectModel& object, const PointSet& cloud, const
   certificate.nd.weak_motion_checked = false;
   certificate.nd.weak_motion = WeakMotionCheck{};
   if (!estimate->ok()) return;
-  if (free_space) certificate.free_space = free_space->Check(estimate->scene_from_model);
+  StageTimes& times = estimate->ms_stages;
+  if (free_space) {
+    const auto start = std::chrono::steady_clock::now();
+    certificate.free_space = free_space->Check(estimate->scene_from_model);
+    times.free_space += MillisecondsSince(start);
+  }
   if (WeakMotionCheckApplies(certificate, options.certificate)) {
+    const auto start = std::chrono::steady_clock::now();
     certificate.nd.weak_motion = CheckWeakMotion(object, cloud, *estimate, options, free_space);
     certificate.nd.weak_motion_checked = true;
     certificate.nd.passed = certificate.nd.sets_passed && certificate.nd.weak_motion.passed;
+    times.weak_motion += MillisecondsSince(start);
   }
   if (options.certificate.global.enabled && certificate.certified()) {
+    const auto start = std::chrono::steady_clock::now();
     certificate.nd.global = CheckGlobalUniqueness(object, cloud, *estimate, options, free_space);
     certificate.nd.global_checked = true;
     certificate.nd.passed = certificate.nd.passed && certificate.nd.global.passed;
+    times.rival_search += MillisecondsSince(start);
   }
 }
 
@@ -180,6 +202,7 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
   PoseEstimate estimate;
   estimate.detected_keypoints = detected_keypoints;
   const PointSet corrector_cloud = StridedColumns(cloud, options.max_corrector_points);
+  auto stage_start = std::chrono::steady_clock::now();
   if (options.correct) {
     // The fast solver's restarts are triggered by the threshold actually
     // certified (a --eps-oc override), not only the object file's.
@@ -199,22 +222,34 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
     no_iterations.gd_max_iterations = 0;
     estimate.correction = CorrectKeypoints(object, corrector_cloud, detected_keypoints, no_iterations);
   }
+  StageTimes times;   // the top level's; the replacements below carry their own
+  times.corrector = MillisecondsSince(stage_start);
   estimate.keypoints = estimate.correction.keypoints;
   estimate.scene_from_model = estimate.correction.scene_from_model;
   if (estimate.ok()) {
+    stage_start = std::chrono::steady_clock::now();
     estimate.certificate = Certify(object, judged, estimate.scene_from_model, estimate.keypoints,
                                    options.certificate);
+    times.certificate = MillisecondsSince(stage_start);
     CompleteCertificate(object, judged, options, free_space, &estimate);
+    times.free_space = estimate.ms_stages.free_space;
+    times.weak_motion = estimate.ms_stages.weak_motion;
+    times.rival_search = estimate.ms_stages.rival_search;
     if (options.correct && options.certificate.global.reestimate && Refuted(estimate.certificate)) {
+      stage_start = std::chrono::steady_clock::now();
       Reestimate(object, cloud, judged, options, free_space, &estimate);
+      times.reestimation = MillisecondsSince(stage_start);
     }
     if (options.correct && options.certificate.global.centre) {
+      stage_start = std::chrono::steady_clock::now();
       Centre(object, judged, options, free_space, &estimate);
+      times.centring = MillisecondsSince(stage_start);
     }
   } else {
     estimate.certificate.oc.eps_oc = options.certificate.eps_oc;
     estimate.certificate.nd.delta_nd = options.certificate.delta_nd;
   }
+  estimate.ms_stages = times;
   estimate.milliseconds =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return estimate;

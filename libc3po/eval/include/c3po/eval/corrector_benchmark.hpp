@@ -10,6 +10,7 @@
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"
 #include "c3po/method/detector.hpp"
+#include "c3po/method/pipeline.hpp"
 #include "c3po/object/object_model.hpp"
 
 namespace c3po {
@@ -45,6 +46,7 @@ struct CorrectorBenchmarkRow {
   double median_corrector_ms = 0.0, mean_corrector_ms = 0.0;   // correction only
   double median_corrector_cpu_ms = 0.0;  // correction only, the thread's CPU time
   double median_certify_ms = 0.0;        // certificates only
+  StageTimes mean_stages;                // mean ms per cloud of each stage (pipeline.hpp; no load, detect)
   double mean_iterations = 0.0;
   // Certificates (oc_m and nd_m) against the Hausdorff distance to the truth.
   double percent_certified = 0.0;
@@ -66,6 +68,7 @@ struct CorrectorBenchmarkCase {
   PointSet detected_keypoints;        // the perturbed ground truth ỹ
   double rotation_deg = 0.0, translation_over_d = 0.0, adds_over_d = 0.0;
   double corrector_ms = 0.0, corrector_cpu_ms = 0.0, certify_ms = 0.0;
+  StageTimes stages;                  // corrector, certificate (Certify), free space, weak motion, rival search
   int iterations = 0;
   double cost_before = 0.0, cost_after = 0.0;   // f(ỹ), f(y*); 0 for registration alone
   bool oc = false;

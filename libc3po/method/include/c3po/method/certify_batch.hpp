@@ -187,7 +187,10 @@ CertifyBatchResult CertifyBatch(const ObjectModel& object, const std::vector<Clo
 //   identity (null when not checked), identity_objects (tried),
 //   identity_rival (the other object certified too; null: none),
 //   identity_rival_oc_distance, identity_rival_R and identity_rival_t (null
-//   without a rival); and last ms. Image-source lines also carry
+//   without a rival); ms; and last ms_stages, an object of the
+//   milliseconds of each stage (StageTimes, pipeline.hpp: load, detect,
+//   corrector, certificate, free_space, weak_motion, rival_search,
+//   reestimation, centring, identity). Image-source lines also carry
 //   gt_hausdorff after gt_t (Hausdorff(T*·B̂, T̂·B̂), metres) when the
 //   ground truth is known.
 constexpr std::size_t kMaxListedOutliers = 100;

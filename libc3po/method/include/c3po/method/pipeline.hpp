@@ -19,6 +19,26 @@ struct PipelineOptions {
   void Check() const;
 };
 
+// Wall-clock milliseconds of each stage of one instance (the `ms_stages` of
+// `--json`). EstimateAndCertify fills the stages from `corrector` on, each
+// timed once at the top level (the rival search includes its refits, the
+// re-estimation its candidates and their certificates); a batch
+// (certify_batch.hpp) adds `load` (reading, segmenting), `detect` and
+// `identity`.
+struct StageTimes {
+  double load = 0.0;
+  double detect = 0.0;
+  double corrector = 0.0;
+  double certificate = 0.0;     // Certify: oc_m, the indicator sets, the local test
+  double free_space = 0.0;
+  double weak_motion = 0.0;
+  double rival_search = 0.0;
+  double reestimation = 0.0;
+  double centring = 0.0;
+  double identity = 0.0;
+  double Total() const;
+};
+
 struct PoseEstimate {
   PointSet detected_keypoints;    // ỹ
   PointSet keypoints;             // corrected y* (= ỹ without correction)
@@ -26,6 +46,7 @@ struct PoseEstimate {
   CorrectorResult correction;     // iterations, costs (trivial without correction)
   Certificate certificate;
   double milliseconds = 0.0;      // correction + certification time (with the identity check, certify_batch.hpp)
+  StageTimes ms_stages;
   // Re-estimation (GlobalUniquenessOptions::reestimate): the estimate failed
   // oc or free space and the corrector restarted at the turn (axis, angle)
   // found the pose reported here (axis: a column of ReestimateAxes, 0-2 the
