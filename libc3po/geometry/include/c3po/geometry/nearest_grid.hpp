@@ -26,11 +26,12 @@ struct NearestGridOptions {
   // Cell edge as a multiple of the points' mean nearest-neighbour spacing,
   // and the gathering reach R in cells. A smaller cell keeps shorter lists
   // (faster queries) and needs more cells; R bounds how far from the points
-  // the grid answers, and the build time grows as R^3. The defaults were
-  // chosen on `c3po bench corrector` (docs/results.md, "Nearest-neighbour
-  // grid"): lists of ~20 points, ~0.1 s to build for 10^4 points.
-  double cell_over_spacing = 2.0;
-  double reach_cells = 3.0;
+  // the grid answers, and the build time and memory grow as R^3. The
+  // defaults were chosen on `c3po bench corrector` (docs/results.md,
+  // "Nearest-neighbour grid"): for 10^4 points, tens of milliseconds and
+  // ~15 MB to build, ~30 points per list.
+  double cell_over_spacing = 2.5;
+  double reach_cells = 4.0;
   std::int64_t max_cells = std::int64_t{1} << 22;   // the cell grows until the grid fits
   void Check() const;
 };
