@@ -65,6 +65,7 @@ def lines(path):
     for line in open(path):
         d = json.loads(line)
         d.pop('ms', None)
+        d.pop('ms_stages', None)
         out.append(d)
     return out
 def csv(path):

@@ -31,7 +31,9 @@ python3 - <<'PY' || fail "merged certify parts differ from the unsharded run"
 import json
 def lines(path):
     out = [json.loads(l) for l in open(path)]
-    for d in out: d.pop('ms', None)
+    for d in out:
+        d.pop('ms', None)
+        d.pop('ms_stages', None)
     return out
 assert len(lines('full.jsonl')) == 9
 assert lines('merged.jsonl') == lines('full.jsonl')

@@ -20,7 +20,7 @@ untimed() {
 import json, sys
 def strip(value):
     if isinstance(value, dict):
-        return {k: strip(v) for k, v in value.items() if k not in ("ms", "seconds")}
+        return {k: strip(v) for k, v in value.items() if k not in ("ms", "ms_stages", "seconds")}
     if isinstance(value, list):
         return [strip(v) for v in value]
     return value
