@@ -43,10 +43,6 @@ double ThreadCpuMilliseconds() {
   return 1e3 * static_cast<double>(now.tv_sec) + 1e-6 * static_cast<double>(now.tv_nsec);
 }
 
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
 // Registration alone (y* = ỹ, T̂ = T(ỹ)) or the corrector, then the
 // certificates, each timed: wall clock, and the thread's CPU time of the
 // correction (robust to other processes sharing the cores).

@@ -166,10 +166,6 @@ void CertifyBatchOptions::Check() const {
 
 namespace {
 
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
 void RequireDetectorOrKeypoints(const std::vector<CloudSource>& sources, const Detector* detector) {
   if (detector) return;
   for (const CloudSource& source : sources) {

@@ -16,13 +16,9 @@ double StageTimes::Total() const {
          identity;
 }
 
-namespace {
-
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
-
-}  // namespace
 
 void PipelineOptions::Check() const {
   if (max_corrector_points < 0) throw std::invalid_argument("max_corrector_points must be >= 0");
@@ -250,8 +246,7 @@ PoseEstimate EstimateAndCertify(const ObjectModel& object, const PointSet& cloud
     estimate.certificate.nd.delta_nd = options.certificate.delta_nd;
   }
   estimate.ms_stages = times;
-  estimate.milliseconds =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  estimate.milliseconds = MillisecondsSince(start);
   return estimate;
 }
 

@@ -136,7 +136,7 @@ std::string ObjectModel::KeypointHash() const {
 
 void ObjectModel::NearestInPosedModel(const PointSet& scene, const Pose& scene_from_model, Eigen::VectorXi* indices,
                                       Eigen::VectorXd* squared_distances, const Eigen::VectorXi* hints) const {
-  // ||x - (R p + t)|| = ||R^T (x - t) - p||: query the model-frame tree.
+  // ||x - (R p + t)|| = ||R^T (x - t) - p||: query the model-frame grid.
   grid().NearestBatch(scene_from_model.InverseApply(scene), indices, squared_distances, hints);
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 // The C-3PO forward pass for one cloud (docs/method.md "Pipeline"): detected
 // keypoints -> registration (eq. 8) -> corrector (eq. 17) -> certificates.
+#include <chrono>
+
 #include "c3po/method/certificate.hpp"
 #include "c3po/method/corrector.hpp"
 #include "c3po/method/free_space.hpp"
@@ -38,6 +40,9 @@ struct StageTimes {
   double identity = 0.0;
   double Total() const;
 };
+
+// Milliseconds of wall clock since `start` (the unit of every stage time).
+double MillisecondsSince(std::chrono::steady_clock::time_point start);
 
 struct PoseEstimate {
   PointSet detected_keypoints;    // ỹ
